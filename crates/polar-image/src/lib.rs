@@ -1,0 +1,155 @@
+//! Typed images. The channel count is part of the type (`Image<T, C>`), so a
+//! 4-channel Stokes image and a 1-channel DoLP image cannot be mixed up.
+//! Pixels are stored row-major and interleaved; row 0 is the top row.
+
+use thiserror::Error;
+
+/// Errors from constructing or combining images.
+#[derive(Debug, Error, PartialEq, Eq)]
+pub enum ImageError {
+    /// The buffer length does not equal `width * height * C`.
+    #[error("buffer of {len} values does not fit a {width}x{height} image with {channels} channel(s)")]
+    BufferSize {
+        /// Buffer length given.
+        len: usize,
+        /// Image width.
+        width: usize,
+        /// Image height.
+        height: usize,
+        /// Channels per pixel.
+        channels: usize,
+    },
+    /// Two images that must have the same size do not.
+    #[error("size mismatch: {0}x{1} vs {2}x{3}")]
+    SizeMismatch(usize, usize, usize, usize),
+}
+
+/// A `width × height` image with `C` interleaved channels of type `T`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image<T, const C: usize> {
+    width: usize,
+    height: usize,
+    data: Vec<T>,
+}
+
+/// A single-channel image (mosaic, DoLP, AoLP, depth, mask, ...).
+pub type Gray<T> = Image<T, 1>;
+/// Linear Stokes `S0, S1, S2` per pixel.
+pub type LinearStokesImage = Image<f32, 3>;
+/// Full Stokes `S0, S1, S2, S3` per pixel.
+pub type StokesImage = Image<f32, 4>;
+/// The four polarizer images `I0, I45, I90, I135` per pixel.
+pub type PolarizerStack = Image<f32, 4>;
+
+impl<T: Clone + Default, const C: usize> Image<T, C> {
+    /// An image filled with `T::default()`.
+    pub fn new(width: usize, height: usize) -> Self {
+        Self { width, height, data: vec![T::default(); width * height * C] }
+    }
+}
+
+impl<T, const C: usize> Image<T, C> {
+    /// Wraps an interleaved row-major buffer, checking its length.
+    pub fn from_vec(width: usize, height: usize, data: Vec<T>) -> Result<Self, ImageError> {
+        if data.len() != width * height * C {
+            return Err(ImageError::BufferSize { len: data.len(), width, height, channels: C });
+        }
+        Ok(Self { width, height, data })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// `(width, height)`.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// The interleaved samples.
+    pub fn as_slice(&self) -> &[T] {
+        &self.data
+    }
+
+    /// The interleaved samples, mutable.
+    pub fn as_mut_slice(&mut self) -> &mut [T] {
+        &mut self.data
+    }
+
+    /// Consumes the image, returning its buffer.
+    pub fn into_vec(self) -> Vec<T> {
+        self.data
+    }
+
+    /// The pixels as `[T; C]` arrays, row-major.
+    pub fn pixels(&self) -> &[[T; C]] {
+        self.data.as_chunks::<C>().0
+    }
+
+    /// The pixels as mutable `[T; C]` arrays, row-major.
+    pub fn pixels_mut(&mut self) -> &mut [[T; C]] {
+        self.data.as_chunks_mut::<C>().0
+    }
+
+    /// Pixel at column `x`, row `y`.
+    pub fn pixel(&self, x: usize, y: usize) -> &[T; C] {
+        &self.pixels()[y * self.width + x]
+    }
+
+    /// Checks that `other` has the same size.
+    pub fn check_same_size<U, const D: usize>(&self, other: &Image<U, D>) -> Result<(), ImageError> {
+        if self.size() == other.size() {
+            Ok(())
+        } else {
+            Err(ImageError::SizeMismatch(self.width, self.height, other.width, other.height))
+        }
+    }
+}
+
+impl<T: Copy, const C: usize> Image<T, C> {
+    /// Channel `c` as a new single-channel image.
+    pub fn channel(&self, c: usize) -> Gray<T> {
+        assert!(c < C, "channel {c} out of range for a {C}-channel image");
+        let data = self.pixels().iter().map(|p| p[c]).collect();
+        Gray { width: self.width, height: self.height, data }
+    }
+
+    /// Builds a `C`-channel image from `C` single-channel images of equal size.
+    pub fn from_channels(channels: [&Gray<T>; C]) -> Result<Self, ImageError> {
+        let (w, h) = channels[0].size();
+        for ch in &channels[1..] {
+            channels[0].check_same_size(*ch)?;
+        }
+        let mut data = Vec::with_capacity(w * h * C);
+        for i in 0..w * h {
+            data.extend(channels.iter().map(|ch| ch.data[i]));
+        }
+        Ok(Self { width: w, height: h, data })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn from_vec_rejects_wrong_length() {
+        let err = Image::<f32, 3>::from_vec(2, 2, vec![0.0; 11]).unwrap_err();
+        assert!(matches!(err, ImageError::BufferSize { len: 11, .. }));
+    }
+
+    #[test]
+    fn channels_round_trip() {
+        let img = Image::<u16, 2>::from_vec(2, 1, vec![1, 2, 3, 4]).unwrap();
+        let (a, b) = (img.channel(0), img.channel(1));
+        assert_eq!(a.as_slice(), &[1, 3]);
+        assert_eq!(Image::from_channels([&a, &b]).unwrap(), img);
+        assert_eq!(img.pixel(1, 0), &[3, 4]);
+    }
+}

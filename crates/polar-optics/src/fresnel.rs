@@ -1,0 +1,102 @@
+//! Fresnel equations for dielectrics and conductors with a complex relative
+//! index `η = n + ik`, as amplitudes and as Mueller matrices in the s/p frame.
+//!
+//! Frames: `s = normalize(n × k_in)` is shared by the incident, reflected and
+//! transmitted beams; each beam's `p = k × s`, so `(s, p, k)` is right-handed and
+//! the Stokes x axis is `s`. With this choice the p amplitude follows Hecht,
+//! `r_p = (η cos θi − cos θt)/(η cos θi + cos θt)`, and normal incidence is
+//! isotropic in the lab frame (`r_p = −r_s` there because `p_out = −p_in`).
+
+use crate::mueller::{Mueller, from_diagonal_jones};
+use num_complex::Complex64;
+
+/// Complex Fresnel amplitudes at one angle of incidence.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FresnelAmplitudes {
+    /// s (perpendicular) reflection amplitude.
+    pub r_s: Complex64,
+    /// p (parallel) reflection amplitude.
+    pub r_p: Complex64,
+    /// s transmission amplitude (ratio of electric fields).
+    pub t_s: Complex64,
+    /// p transmission amplitude (ratio of electric fields).
+    pub t_p: Complex64,
+    /// `η cos θt = sqrt(η² − sin² θi)` on the branch with `Im ≥ 0` (decaying wave).
+    pub eta_cos_t: Complex64,
+    /// The cosine of the angle of incidence used, clamped to `[0, 1]`.
+    pub cos_i: f64,
+}
+
+/// Fresnel amplitudes for incidence cosine `cos_i` (clamped to `[0, 1]`; NaN
+/// propagates) and relative index `eta = n_t / n_i` (complex for conductors).
+///
+/// `η cos θt` is computed as `sqrt(η² − sin²θi)` with the branch `Im ≥ 0`, which
+/// is both the physical decaying wave for conductors and the evanescent wave of
+/// total internal reflection; no division by `η` occurs, so `k → 0` and large
+/// `k` are stable. Index matching (`η = 1`) returns `r = 0`, `t = 1` exactly.
+pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
+    let cos_i = if cos_i.is_nan() { cos_i } else { cos_i.clamp(0.0, 1.0) };
+    let one = Complex64::new(1.0, 0.0);
+    if eta == one {
+        let eta_cos_t = Complex64::new(cos_i, 0.0);
+        let zero = Complex64::new(0.0, 0.0);
+        return FresnelAmplitudes { r_s: zero, r_p: zero, t_s: one, t_p: one, eta_cos_t, cos_i };
+    }
+    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+    let mut d = eta * eta - sin2_i;
+    // Keep the branch cut on the correct side for real negative arguments (TIR).
+    if d.im == 0.0 {
+        d.im = 0.0;
+    }
+    let eta_cos_t = d.sqrt();
+    let ci = Complex64::new(cos_i, 0.0);
+    let eta2_ci = eta * eta * cos_i;
+    let r_s = (ci - eta_cos_t) / (ci + eta_cos_t);
+    let r_p = (eta2_ci - eta_cos_t) / (eta2_ci + eta_cos_t);
+    let t_s = 2.0 * ci / (ci + eta_cos_t);
+    let t_p = 2.0 * eta * ci / (eta2_ci + eta_cos_t);
+    FresnelAmplitudes { r_s, r_p, t_s, t_p, eta_cos_t, cos_i }
+}
+
+impl FresnelAmplitudes {
+    /// Power reflectances `(R_s, R_p)`.
+    pub fn reflectance(&self) -> (f64, f64) {
+        (self.r_s.norm_sqr(), self.r_p.norm_sqr())
+    }
+
+    /// Power transmittances `(T_s, T_p) = Re(η cos θt)/cos θi · |t|²` (energy flux
+    /// across the interface, real `η` only); 0 at grazing incidence and under TIR.
+    pub fn transmittance(&self) -> (f64, f64) {
+        let f = self.flux_factor();
+        (f * self.t_s.norm_sqr(), f * self.t_p.norm_sqr())
+    }
+
+    /// `Re(η cos θt) / cos θi`, the ratio of flux densities; 0 where `cos θi = 0`.
+    fn flux_factor(&self) -> f64 {
+        if self.cos_i > 0.0 { self.eta_cos_t.re.max(0.0) / self.cos_i } else { 0.0 }
+    }
+
+    /// Mueller matrix of specular reflection in the s/p frames (x = s).
+    pub fn reflection_mueller(&self) -> Mueller {
+        from_diagonal_jones(self.r_s, self.r_p)
+    }
+
+    /// Mueller matrix of specular transmission in the s/p frames (x = s), in
+    /// units of energy flux (so that `R + T = 1` for a lossless dielectric).
+    /// A renderer carrying radiance must further scale by `1/η²`.
+    pub fn transmission_mueller(&self) -> Mueller {
+        let f = self.flux_factor().sqrt();
+        from_diagonal_jones(self.t_s * f, self.t_p * f)
+    }
+}
+
+/// Mueller matrix of specular reflection in the s/p frames: shorthand for
+/// `fresnel_amplitudes(cos_i, eta).reflection_mueller()`.
+pub fn reflection_mueller(cos_i: f64, eta: Complex64) -> Mueller {
+    fresnel_amplitudes(cos_i, eta).reflection_mueller()
+}
+
+/// Mueller matrix of specular transmission in the s/p frames (energy-flux units).
+pub fn transmission_mueller(cos_i: f64, eta: Complex64) -> Mueller {
+    fresnel_amplitudes(cos_i, eta).transmission_mueller()
+}
