@@ -24,7 +24,11 @@ pub fn basis_angle(k: &Vector3<f64>, current: &Vector3<f64>, target: &Vector3<f6
 
 /// Mueller matrix that re-expresses a Stokes vector travelling along `k` from the
 /// frame with x axis `current` into the frame with x axis `target`.
-pub fn rotate_stokes_basis(k: &Vector3<f64>, current: &Vector3<f64>, target: &Vector3<f64>) -> Mueller {
+pub fn rotate_stokes_basis(
+    k: &Vector3<f64>,
+    current: &Vector3<f64>,
+    target: &Vector3<f64>,
+) -> Mueller {
     rotator(basis_angle(k, current, target))
 }
 
@@ -40,5 +44,7 @@ pub fn rotate_mueller_basis(
     out_current: &Vector3<f64>,
     out_target: &Vector3<f64>,
 ) -> Mueller {
-    rotate_stokes_basis(out_k, out_current, out_target) * m * rotate_stokes_basis(in_k, in_target, in_current)
+    rotate_stokes_basis(out_k, out_current, out_target)
+        * m
+        * rotate_stokes_basis(in_k, in_target, in_current)
 }

@@ -7,7 +7,8 @@
 //! `r_p = (η cos θi − cos θt)/(η cos θi + cos θt)`, and normal incidence is
 //! isotropic in the lab frame (`r_p = −r_s` there because `p_out = −p_in`).
 
-use crate::mueller::{Mueller, from_diagonal_jones};
+use crate::block::BlockDiagonal;
+use crate::mueller::Mueller;
 use num_complex::Complex64;
 
 /// Complex Fresnel amplitudes at one angle of incidence.
@@ -27,20 +28,58 @@ pub struct FresnelAmplitudes {
     pub cos_i: f64,
 }
 
-/// Fresnel amplitudes for incidence cosine `cos_i` (clamped to `[0, 1]`; NaN
-/// propagates) and relative index `eta = n_t / n_i` (complex for conductors).
+/// Fresnel amplitudes for incidence cosine `cos_i` and relative index
+/// `eta = n_t / n_i` (complex `n + ik`, `k ≥ 0`, for conductors).
 ///
 /// `η cos θt` is computed as `sqrt(η² − sin²θi)` with the branch `Im ≥ 0`, which
 /// is both the physical decaying wave for conductors and the evanescent wave of
 /// total internal reflection; no division by `η` occurs, so `k → 0` and large
-/// `k` are stable. Index matching (`η = 1`) returns `r = 0`, `t = 1` exactly.
+/// `k` are stable. With `c = cos θi`, `w = η cos θt` (Born & Wolf §1.5.2, Hecht (4.42)):
+/// `r_s = (c − w)/(c + w)`, `r_p = (η² c − w)/(η² c + w)`, `t_s = 2c/(c + w)`,
+/// `t_p = 2ηc/(η² c + w)`.
+///
+/// Edge cases (all without NaN): `cos_i` is clamped to `[0, 1]` (grazing `cos_i = 0`
+/// gives `r_s = r_p = −1`); index matching `η = 1` returns `r = 0`, `t = 1` exactly;
+/// `|η| > 1e150` or infinite is the perfect-conductor limit `r_s = −1`, `r_p = +1`
+/// (`−1` at grazing), `t = 0`, so that `η²` never overflows. Undefined inputs give
+/// NaN amplitudes: a NaN or infinite `cos_i`, or a NaN component of `eta`.
 pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
-    let cos_i = if cos_i.is_nan() { cos_i } else { cos_i.clamp(0.0, 1.0) };
+    let zero = Complex64::new(0.0, 0.0);
     let one = Complex64::new(1.0, 0.0);
+    if !cos_i.is_finite() || eta.is_nan() {
+        let nan = Complex64::new(f64::NAN, f64::NAN);
+        return FresnelAmplitudes {
+            r_s: nan,
+            r_p: nan,
+            t_s: nan,
+            t_p: nan,
+            eta_cos_t: nan,
+            cos_i: f64::NAN,
+        };
+    }
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let ci = Complex64::new(cos_i, 0.0);
     if eta == one {
-        let eta_cos_t = Complex64::new(cos_i, 0.0);
-        let zero = Complex64::new(0.0, 0.0);
-        return FresnelAmplitudes { r_s: zero, r_p: zero, t_s: one, t_p: one, eta_cos_t, cos_i };
+        return FresnelAmplitudes {
+            r_s: zero,
+            r_p: zero,
+            t_s: one,
+            t_p: one,
+            eta_cos_t: ci,
+            cos_i,
+        };
+    }
+    if eta.norm() > PERFECT_CONDUCTOR {
+        let r_p = if cos_i > 0.0 { one } else { -one };
+        let eta_cos_t = Complex64::new(0.0, f64::INFINITY);
+        return FresnelAmplitudes {
+            r_s: -one,
+            r_p,
+            t_s: zero,
+            t_p: zero,
+            eta_cos_t,
+            cos_i,
+        };
     }
     let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
     let mut d = eta * eta - sin2_i;
@@ -49,14 +88,24 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
         d.im = 0.0;
     }
     let eta_cos_t = d.sqrt();
-    let ci = Complex64::new(cos_i, 0.0);
     let eta2_ci = eta * eta * cos_i;
     let r_s = (ci - eta_cos_t) / (ci + eta_cos_t);
     let r_p = (eta2_ci - eta_cos_t) / (eta2_ci + eta_cos_t);
     let t_s = 2.0 * ci / (ci + eta_cos_t);
     let t_p = 2.0 * eta * ci / (eta2_ci + eta_cos_t);
-    FresnelAmplitudes { r_s, r_p, t_s, t_p, eta_cos_t, cos_i }
+    FresnelAmplitudes {
+        r_s,
+        r_p,
+        t_s,
+        t_p,
+        eta_cos_t,
+        cos_i,
+    }
 }
+
+/// Above this `|η|` the interface is treated as a perfect conductor (relative
+/// error `~1/|η|`, and `η²` would overflow near `1e154`).
+const PERFECT_CONDUCTOR: f64 = 1e150;
 
 impl FresnelAmplitudes {
     /// Power reflectances `(R_s, R_p)`.
@@ -73,20 +122,41 @@ impl FresnelAmplitudes {
 
     /// `Re(η cos θt) / cos θi`, the ratio of flux densities; 0 where `cos θi = 0`.
     fn flux_factor(&self) -> f64 {
-        if self.cos_i > 0.0 { self.eta_cos_t.re.max(0.0) / self.cos_i } else { 0.0 }
+        if self.cos_i > 0.0 {
+            self.eta_cos_t.re.max(0.0) / self.cos_i
+        } else {
+            0.0
+        }
     }
 
     /// Mueller matrix of specular reflection in the s/p frames (x = s).
     pub fn reflection_mueller(&self) -> Mueller {
-        from_diagonal_jones(self.r_s, self.r_p)
+        self.reflection_block().to_mueller()
+    }
+
+    /// [`Self::reflection_mueller`] in block-diagonal form, for the fast path.
+    pub fn reflection_block(&self) -> BlockDiagonal {
+        BlockDiagonal::from_diagonal_jones(self.r_s, self.r_p)
+    }
+
+    /// Phase retardance of reflection `arg(r_s) − arg(r_p)` wrapped to `(−π, π]`.
+    /// Under total internal reflection (`η < 1`, `sin θi > η`) it obeys
+    /// `tan(δ/2) = cos θi sqrt(sin²θi − η²) / sin²θi` (Born & Wolf §1.5.4).
+    pub fn reflection_phase(&self) -> f64 {
+        (self.r_s * self.r_p.conj()).arg()
     }
 
     /// Mueller matrix of specular transmission in the s/p frames (x = s), in
     /// units of energy flux (so that `R + T = 1` for a lossless dielectric).
     /// A renderer carrying radiance must further scale by `1/η²`.
     pub fn transmission_mueller(&self) -> Mueller {
+        self.transmission_block().to_mueller()
+    }
+
+    /// [`Self::transmission_mueller`] in block-diagonal form, for the fast path.
+    pub fn transmission_block(&self) -> BlockDiagonal {
         let f = self.flux_factor().sqrt();
-        from_diagonal_jones(self.t_s * f, self.t_p * f)
+        BlockDiagonal::from_diagonal_jones(self.t_s * f, self.t_p * f)
     }
 }
 

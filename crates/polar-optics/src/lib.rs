@@ -1,6 +1,7 @@
 //! The physics of polarized light, written once and used by both the simulator
 //! and the analysis: Stokes vectors, Mueller matrices, Fresnel equations for
-//! dielectrics and conductors, and reference-frame rotations.
+//! dielectrics and conductors, reference-frame rotations, validity checks and
+//! the Lu–Chipman decomposition.
 //!
 //! Conventions (see the project README, "Conventions"):
 //! - A Stokes vector is expressed in a reference frame `(x, y)` perpendicular to
@@ -8,15 +9,26 @@
 //! - Angles (polarizer, AoLP) run from `x` toward `y`; AoLP lies in `[0, π)`.
 //! - `S1 = I0 − I90`, `S2 = I45 − I135`, `S3 = I_RCP − I_LCP`, right-handed meaning
 //!   the field turns clockwise for an observer facing the source (as Mitsuba 3).
+//!   In Jones terms `S3 = 2 Im(E_x E_y*)`; `E_y = −i E_x` is right-handed.
 //! - Complex refractive indices are `n + ik` with `k ≥ 0` absorbing and the time
 //!   dependence `exp(−iωt)`.
+//! - Undefined results are NaN (e.g. DoLP of `S0 = 0`, Fresnel of a NaN angle);
+//!   where a value is defined no NaN is produced (grazing incidence, the critical
+//!   angle, `k → 0`, `k → ∞`, index matching).
 
-pub mod fresnel;
+pub mod block;
+pub mod decompose;
+pub mod error;
 pub mod frame;
+pub mod fresnel;
 pub mod mueller;
 pub mod stokes;
+pub mod validity;
 
-pub use fresnel::{FresnelAmplitudes, fresnel_amplitudes};
+pub use block::BlockDiagonal;
+pub use decompose::{LuChipman, lu_chipman};
+pub use error::OpticsError;
 pub use frame::{rotate_mueller_basis, rotate_stokes_basis, stokes_basis};
-pub use mueller::Mueller;
-pub use stokes::Stokes;
+pub use fresnel::{FresnelAmplitudes, fresnel_amplitudes};
+pub use mueller::{LinearMueller, Mueller};
+pub use stokes::{LinearStokes, LinearStokesFit, Stokes};

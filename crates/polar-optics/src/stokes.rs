@@ -3,11 +3,27 @@
 //! The scalar functions are generic over `f32`/`f64` so that image code runs the
 //! very same formulas per pixel at full speed.
 
-use nalgebra::Vector4;
+use crate::error::OpticsError;
+use nalgebra::{Matrix3, Matrix3xX, OMatrix, U3, Vector3, Vector4};
 use num_traits::Float;
 
 /// A full Stokes vector `(S0, S1, S2, S3)` in some reference frame.
 pub type Stokes = Vector4<f64>;
+
+/// The linear part `(S0, S1, S2)` of a Stokes vector, for scenes that never
+/// create circular polarization (no retarders, no total internal reflection, no
+/// metals); pair it with [`crate::mueller::LinearMueller`].
+pub type LinearStokes = Vector3<f64>;
+
+/// Drops `S3`: the linear part `(S0, S1, S2)`.
+pub fn to_linear(s: &Stokes) -> LinearStokes {
+    s.fixed_rows::<3>(0).into_owned()
+}
+
+/// Extends a linear Stokes vector with `S3 = 0`.
+pub fn from_linear(s: &LinearStokes) -> Stokes {
+    Stokes::new(s[0], s[1], s[2], 0.0)
+}
 
 /// Unpolarized light of intensity `s0`.
 pub fn unpolarized(s0: f64) -> Stokes {
@@ -119,4 +135,98 @@ pub fn is_physical(s: &Stokes, tol: f64) -> bool {
     s.iter().all(|v| v.is_finite())
         && s[0] >= 0.0
         && s[1].hypot(s[2]).hypot(s[3]) <= s[0] * (1.0 + tol) + tol * f64::MIN_POSITIVE.sqrt()
+}
+
+/// Least-squares linear Stokes from intensities behind ideal polarizers at any
+/// set of angles, solved once per angle set and then applied to many pixels.
+///
+/// The model is `I(θ_i) = ½ (S0 + S1 cos 2θ_i + S2 sin 2θ_i)`, i.e. `I = A s` with
+/// rows `A_i = ½ (1, cos 2θ_i, sin 2θ_i)`; the fit is `s = (AᵀA)⁻¹ Aᵀ I`, stored as the
+/// 3×N pseudo-inverse. For 0°/45°/90°/135° it reduces to [`linear_stokes_from_quad`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearStokesFit {
+    pinv: Matrix3xX<f64>,
+}
+
+/// Angles closer than this (radians, modulo π) count as the same polarizer.
+const SAME_ANGLE: f64 = 1e-6;
+
+impl LinearStokesFit {
+    /// Prepares the fit for polarizer `angles` (radians from x toward y).
+    ///
+    /// Errors: a non-finite angle, or fewer than three angles distinct modulo π
+    /// (three distinct points on the circle `2θ` always make `AᵀA` invertible).
+    pub fn new(angles: &[f64]) -> Result<Self, OpticsError> {
+        if let Some((index, &value)) = angles.iter().enumerate().find(|(_, a)| !a.is_finite()) {
+            return Err(OpticsError::NonFinite {
+                what: "angles",
+                index,
+                value,
+            });
+        }
+        let distinct = count_distinct_mod_pi(angles);
+        if distinct < 3 {
+            return Err(OpticsError::TooFewAngles { distinct });
+        }
+        let a = OMatrix::<f64, nalgebra::Dyn, U3>::from_fn(angles.len(), |i, j| {
+            let (s, c) = (2.0 * angles[i]).sin_cos();
+            0.5 * [1.0, c, s][j]
+        });
+        let ata: Matrix3<f64> = a.transpose() * &a;
+        let inv = ata
+            .try_inverse()
+            .ok_or(OpticsError::TooFewAngles { distinct })?;
+        Ok(Self {
+            pinv: inv * a.transpose(),
+        })
+    }
+
+    /// The 3×N matrix `(AᵀA)⁻¹ Aᵀ`: row `j` holds the weights of each intensity in `S_j`.
+    pub fn pseudo_inverse(&self) -> &Matrix3xX<f64> {
+        &self.pinv
+    }
+
+    /// `(S0, S1, S2)` from one intensity per angle (same order as the angles).
+    /// NaN or Inf intensities propagate into the result.
+    pub fn fit(&self, intensities: &[f64]) -> Result<LinearStokes, OpticsError> {
+        let n = self.pinv.ncols();
+        if intensities.len() != n {
+            return Err(OpticsError::LengthMismatch {
+                angles: n,
+                intensities: intensities.len(),
+            });
+        }
+        Ok(self.pinv.columns(0, n) * nalgebra::DVector::from_column_slice(intensities))
+    }
+}
+
+/// One-shot least-squares linear Stokes from `intensities` measured behind ideal
+/// polarizers at `angles`; see [`LinearStokesFit`].
+pub fn linear_stokes_least_squares(
+    angles: &[f64],
+    intensities: &[f64],
+) -> Result<LinearStokes, OpticsError> {
+    if angles.len() != intensities.len() {
+        return Err(OpticsError::LengthMismatch {
+            angles: angles.len(),
+            intensities: intensities.len(),
+        });
+    }
+    LinearStokesFit::new(angles)?.fit(intensities)
+}
+
+/// Number of angles distinct modulo π (a polarizer at θ and at θ + π is the same).
+fn count_distinct_mod_pi(angles: &[f64]) -> usize {
+    let pi = std::f64::consts::PI;
+    let mut kept: Vec<f64> = Vec::new();
+    for a in angles.iter().map(|a| a.rem_euclid(pi)) {
+        let same = |b: &f64| {
+            let d = (a - b).abs();
+            d.min(pi - d) < SAME_ANGLE
+        };
+        if !kept.iter().any(same) {
+            kept.push(a);
+        }
+    }
+    kept.len()
 }
