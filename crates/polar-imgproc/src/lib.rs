@@ -1,0 +1,94 @@
+//! Classic image-processing primitives for the analysis crates, each validated
+//! against the implementation users trust (OpenCV 5 / opencv-contrib, scikit-image 0.26)
+//! by golden files written by `tools/imgproc_goldens.py`.
+//!
+//! Conventions (as in kornia-rs): an operation takes `(&src, &mut dst)` and returns
+//! `Result<(), Error>`; the caller allocates `dst` with the right size; nothing here does
+//! I/O. Images are [`Gray<f32>`](polar_image::Gray) (and `Gray<u8>` for masks, `Gray<u32>`
+//! for label maps). Every function states which OpenCV border mode it reproduces.
+//! Work is split over rows with rayon.
+
+mod border;
+mod filter;
+mod guided;
+mod label;
+mod median;
+mod metrics;
+mod morph;
+mod threshold;
+
+pub use border::Border;
+pub use filter::{
+    box_filter, gaussian_blur, gaussian_kernel, scharr, sep_filter, sobel, sobel_kernels,
+};
+pub use guided::guided_filter;
+pub use label::{ComponentStats, Connectivity, component_stats, label};
+pub use median::{median_blur, median_blur_u8};
+pub use metrics::{AngularErrorStats, ConfusionMatrix, angular_error, iou, psnr, ssim, ssim_map};
+pub use morph::{MorphShape, close, dilate, erode, max_filter, min_filter, open};
+pub use threshold::{threshold_otsu, threshold_otsu_u8};
+
+use thiserror::Error;
+
+/// Errors of the image-processing primitives.
+#[derive(Debug, Error, PartialEq)]
+pub enum Error {
+    /// Source and destination (or two inputs) differ in size.
+    #[error("size mismatch: {0}x{1} vs {2}x{3}")]
+    SizeMismatch(usize, usize, usize, usize),
+    /// The image has no pixels.
+    #[error("empty image ({0}x{1})")]
+    Empty(usize, usize),
+    /// A kernel size is not allowed (must be odd and in the supported set).
+    #[error("kernel size {ksize} not supported: {reason}")]
+    KernelSize {
+        /// Requested kernel size.
+        ksize: usize,
+        /// What is allowed.
+        reason: &'static str,
+    },
+    /// A parameter is out of its valid range.
+    #[error("invalid parameter {name} = {value}: {reason}")]
+    Parameter {
+        /// Parameter name.
+        name: &'static str,
+        /// Given value.
+        value: f64,
+        /// What is allowed.
+        reason: &'static str,
+    },
+    /// The input holds a NaN or infinite value where only finite values make sense.
+    #[error("non-finite value in input")]
+    NonFinite,
+    /// A label or class value is outside `0..n_classes`.
+    #[error("class value {value} outside 0..{n_classes}")]
+    ClassOutOfRange {
+        /// Offending value.
+        value: u32,
+        /// Number of classes.
+        n_classes: usize,
+    },
+}
+
+/// Checks that two images have the same size.
+pub(crate) fn same_size<T, U, const C: usize, const D: usize>(
+    a: &polar_image::Image<T, C>,
+    b: &polar_image::Image<U, D>,
+) -> Result<(), Error> {
+    if a.size() != b.size() {
+        return Err(Error::SizeMismatch(
+            a.width(),
+            a.height(),
+            b.width(),
+            b.height(),
+        ));
+    }
+    if a.width() == 0 || a.height() == 0 {
+        return Err(Error::Empty(a.width(), a.height()));
+    }
+    Ok(())
+}
+
+/// Rows per rayon task: big enough to amortise the halo rows a band recomputes,
+/// small enough to keep a band's scratch in L2 and both cores busy.
+pub(crate) const BAND_ROWS: usize = 32;
