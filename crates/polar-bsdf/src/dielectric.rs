@@ -1,0 +1,173 @@
+//! Dielectric interfaces (glass): smooth, or GGX-rough after Walter et al. 2007,
+//! with polarized Fresnel reflection and transmission per (micro)facet and total
+//! internal reflection. Two-sided: `wo.z < 0` means the viewer is inside.
+//!
+//! Transmission carries radiance: the flux-unit Fresnel matrix is scaled by
+//! `1/η²` with `η = n(wi side) / n(wo side)` (the `eta` of the sample).
+
+use crate::geometry::{V3, reflect, reflect_z, reflectance, reflection, refract, transmission};
+use crate::microfacet::Ggx;
+use crate::{BsdfSample, Model, Polarization};
+use polar_optics::Mueller;
+
+/// A dielectric interface: smooth when `roughness` is `None`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dielectric {
+    /// Interior over exterior index, `n_inside / n_outside` (inside is `z < 0`).
+    pub eta: f64,
+    /// Microfacet distribution; `None` for a smooth interface.
+    pub roughness: Option<Ggx>,
+}
+
+impl Dielectric {
+    /// `n(other side) / n(side of w)`.
+    fn etap(&self, w: &V3) -> f64 {
+        if w.z > 0.0 { self.eta } else { 1.0 / self.eta }
+    }
+
+    fn smooth_sample(&self, wo: &V3, u: f64) -> Option<BsdfSample> {
+        let etap = self.etap(wo);
+        let wr = reflect_z(wo);
+        let r_mueller = reflection(etap.into(), &V3::z(), wo, &wr);
+        let r = r_mueller[(0, 0)];
+        let n = V3::z() * wo.z.signum();
+        match refract(wo, &n, etap) {
+            Some(wt) if u >= r => {
+                let t = transmission(1.0 / etap, &V3::z(), wo, &wt) / (etap * etap);
+                let pt = 1.0 - r;
+                Some(BsdfSample {
+                    wi: wt,
+                    weight: t / pt,
+                    pdf: pt,
+                    is_delta: true,
+                    is_transmission: true,
+                    eta: etap,
+                })
+            }
+            Some(_) => Some(delta_reflection(wr, r_mueller / r, r)),
+            None => Some(delta_reflection(wr, r_mueller, 1.0)),
+        }
+    }
+
+    /// The generalized half vector of `(wo, wi)` facing `+z`, the relative index
+    /// `n(wi side) / n(wo side)`, or `None` for grazing or back-facing configurations.
+    fn half_vector(&self, wo: &V3, wi: &V3) -> Option<(V3, f64)> {
+        if wo.z == 0.0 || wi.z == 0.0 {
+            return None;
+        }
+        let etap = if wo.z * wi.z > 0.0 {
+            1.0
+        } else {
+            self.etap(wo)
+        };
+        let h = wi * etap + wo;
+        if h.norm_squared() == 0.0 {
+            return None;
+        }
+        let h = h.normalize() * h.z.signum();
+        let front = h.dot(wi) * wi.z > 0.0 && h.dot(wo) * wo.z > 0.0;
+        front.then_some((h, etap))
+    }
+
+    /// Probability of choosing reflection at microfacet `h`: the unpolarized
+    /// Fresnel reflectance for light arriving from the side of `wo`.
+    fn reflect_prob(&self, wo: &V3, h: &V3) -> f64 {
+        reflectance(wo.dot(h).abs(), self.etap(wo))
+    }
+
+    fn rough_eval(&self, ggx: &Ggx, wo: &V3, wi: &V3) -> Mueller {
+        let Some((h, etap)) = self.half_vector(wo, wi) else {
+            return Mueller::zeros();
+        };
+        let dg = ggx.d(&h) * ggx.g(wo, wi, &h);
+        if wo.z * wi.z > 0.0 {
+            return reflection(self.etap(wo).into(), &h, wo, wi) * (dg / (4.0 * wo.z.abs()));
+        }
+        let (ci, co) = (wi.dot(&h), wo.dot(&h));
+        let denom = (ci + co / etap).powi(2) * wo.z.abs() * etap * etap;
+        transmission(1.0 / etap, &h, wo, wi) * (dg * (ci * co).abs() / denom)
+    }
+
+    fn rough_pdf(&self, ggx: &Ggx, wo: &V3, wi: &V3) -> f64 {
+        let Some((h, etap)) = self.half_vector(wo, wi) else {
+            return 0.0;
+        };
+        let r = self.reflect_prob(wo, &h);
+        let pdf_h = ggx.pdf_visible(wo, &h);
+        if wo.z * wi.z > 0.0 {
+            pdf_h * r / (4.0 * wo.dot(&h).abs())
+        } else {
+            let ci = wi.dot(&h);
+            pdf_h * (1.0 - r) * ci.abs() / (ci + wo.dot(&h) / etap).powi(2)
+        }
+    }
+
+    fn rough_sample(&self, ggx: &Ggx, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
+        let h = ggx.sample_visible(wo, [u[1], u[2]]);
+        let wi = if u[0] < self.reflect_prob(wo, &h) {
+            reflect(wo, &h)
+        } else {
+            let facing = h * wo.dot(&h).signum();
+            refract(wo, &facing, self.etap(wo))?
+        };
+        let pdf = self.rough_pdf(ggx, wo, &wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        let is_transmission = wo.z * wi.z < 0.0;
+        let eta = if is_transmission { self.etap(wo) } else { 1.0 };
+        let weight = self.rough_eval(ggx, wo, &wi) / pdf;
+        Some(BsdfSample {
+            wi,
+            weight,
+            pdf,
+            is_delta: false,
+            is_transmission,
+            eta,
+        })
+    }
+}
+
+fn delta_reflection(wi: V3, weight: Mueller, pdf: f64) -> BsdfSample {
+    BsdfSample {
+        wi,
+        weight,
+        pdf,
+        is_delta: true,
+        is_transmission: false,
+        eta: 1.0,
+    }
+}
+
+impl Model for Dielectric {
+    fn eval(&self, wo: &V3, wi: &V3) -> Mueller {
+        self.roughness
+            .as_ref()
+            .map_or_else(Mueller::zeros, |ggx| self.rough_eval(ggx, wo, wi))
+    }
+
+    fn pdf(&self, wo: &V3, wi: &V3) -> f64 {
+        self.roughness
+            .as_ref()
+            .map_or(0.0, |ggx| self.rough_pdf(ggx, wo, wi))
+    }
+
+    fn sample(&self, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        match &self.roughness {
+            Some(ggx) => self.rough_sample(ggx, wo, u),
+            None => self.smooth_sample(wo, u[0]),
+        }
+    }
+
+    fn has_delta(&self) -> bool {
+        self.roughness.is_none()
+    }
+
+    /// Total internal reflection adds a phase between s and p: circular light.
+    fn polarization(&self) -> Polarization {
+        Polarization::Full
+    }
+}

@@ -1,0 +1,118 @@
+//! Local-frame geometry shared by the BSDFs: mirror and refraction directions,
+//! cosine-weighted hemisphere sampling, and the one recipe that turns an s/p
+//! Fresnel Mueller matrix into the implicit Stokes bases of the BSDF interface.
+
+use nalgebra::Vector3;
+use polar_optics::fresnel::fresnel_amplitudes;
+use polar_optics::{Mueller, rotate_mueller_basis, stokes_basis};
+use std::f64::consts::{FRAC_1_PI, PI};
+
+/// Local-frame vector.
+pub(crate) type V3 = Vector3<f64>;
+
+/// Below this squared length a cross product is treated as degenerate.
+const DEGENERATE_SQ: f64 = 1e-24;
+
+/// Mirror direction of `w` about the unit normal `m`: `2 (w·m) m − w`.
+pub(crate) fn reflect(w: &V3, m: &V3) -> V3 {
+    2.0 * w.dot(m) * m - w
+}
+
+/// Mirror direction of `w` about the macro normal `z`.
+pub(crate) fn reflect_z(w: &V3) -> V3 {
+    V3::new(-w.x, -w.y, w.z)
+}
+
+/// Refraction of `w` (pointing away from the surface, `w·m > 0`) through the
+/// interface with normal `m`, where `etap = n_other / n_w` (Snell). `None` under
+/// total internal reflection.
+pub(crate) fn refract(w: &V3, m: &V3, etap: f64) -> Option<V3> {
+    let cos_w = w.dot(m);
+    let sin2_t = (1.0 - cos_w * cos_w).max(0.0) / (etap * etap);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some(-w / etap + (cos_w / etap - cos_t) * m)
+}
+
+/// Cosine-weighted direction on the upper hemisphere (Malley's method, concentric disk).
+pub(crate) fn cosine_hemisphere(u: [f64; 2]) -> V3 {
+    let (a, b) = (2.0 * u[0] - 1.0, 2.0 * u[1] - 1.0);
+    let (r, phi) = if a == 0.0 && b == 0.0 {
+        (0.0, 0.0)
+    } else if a.abs() > b.abs() {
+        (a, 0.25 * PI * (b / a))
+    } else {
+        (b, 0.5 * PI - 0.25 * PI * (a / b))
+    };
+    let (x, y) = (r * phi.cos(), r * phi.sin());
+    V3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt())
+}
+
+/// Solid-angle density of [`cosine_hemisphere`]: `cos θ / π` (0 below the horizon).
+pub(crate) fn cosine_hemisphere_pdf(w: &V3) -> f64 {
+    w.z.max(0.0) * FRAC_1_PI
+}
+
+/// The s axis of the plane of incidence spanned by `normal` and `k`:
+/// `normalize(normal × k)`; any axis perpendicular to `k` when they are collinear
+/// (normal incidence, where the Fresnel matrix is isotropic).
+pub(crate) fn s_axis(normal: &V3, k: &V3) -> V3 {
+    let c = normal.cross(k);
+    let n2 = c.norm_squared();
+    if n2 > DEGENERATE_SQ {
+        c / n2.sqrt()
+    } else {
+        stokes_basis(k)
+    }
+}
+
+/// Re-expresses a Mueller matrix given with input x axis `s_in` (light along
+/// `k_in`) and output x axis `s_out` (light along `k_out`) in the interface's
+/// bases: `stokes_basis(k_in)` and `stokes_basis(k_out)`.
+pub(crate) fn to_bsdf_bases(m: &Mueller, k_in: &V3, s_in: &V3, k_out: &V3, s_out: &V3) -> Mueller {
+    rotate_mueller_basis(
+        m,
+        k_in,
+        s_in,
+        &stokes_basis(k_in),
+        k_out,
+        s_out,
+        &stokes_basis(k_out),
+    )
+}
+
+/// Fresnel reflection at the (micro)normal `m` of light arriving along `-wi` and
+/// leaving along `wo`, for relative index `eta = n_transmitted / n_incident`
+/// (complex for conductors), in the BSDF bases.
+pub(crate) fn reflection(eta: num_complex::Complex64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
+    let k_in = -wi;
+    let f = fresnel_amplitudes(wi.dot(m).abs(), eta).reflection_mueller();
+    let s = s_axis(m, &k_in);
+    to_bsdf_bases(&f, &k_in, &s, wo, &s)
+}
+
+/// Fresnel transmission (energy-flux units, no radiance scaling) at the
+/// (micro)normal `m` of light arriving along `-wi` and leaving along `wo`, for the
+/// real relative index `eta = n_wo_side / n_wi_side`, in the BSDF bases.
+pub(crate) fn transmission(eta: f64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
+    let k_in = -wi;
+    let f = fresnel_amplitudes(wi.dot(m).abs(), eta.into()).transmission_mueller();
+    let s = s_axis(m, &k_in);
+    to_bsdf_bases(&f, &k_in, &s, wo, &s)
+}
+
+/// Unpolarized reflectance `(R_s + R_p) / 2` of light arriving at `cos_i` for relative index `eta`.
+pub(crate) fn reflectance(cos_i: f64, eta: f64) -> f64 {
+    let (rs, rp) = fresnel_amplitudes(cos_i, eta.into()).reflectance();
+    0.5 * (rs + rp)
+}
+
+/// A Mueller matrix that only keeps intensity: `value` at (0, 0), zero elsewhere
+/// (an ideal depolarizer with gain `value`).
+pub(crate) fn depolarizer(value: f64) -> Mueller {
+    let mut m = Mueller::zeros();
+    m[(0, 0)] = value;
+    m
+}

@@ -1,0 +1,55 @@
+//! Ideal depolarizing Lambertian reflector: `f = albedo / π`, output unpolarized
+//! whatever the input.
+
+use crate::geometry::{V3, cosine_hemisphere, cosine_hemisphere_pdf, depolarizer};
+use crate::{BsdfSample, Model, Polarization};
+use polar_optics::Mueller;
+use std::f64::consts::FRAC_1_PI;
+
+/// Lambertian reflector with the given albedo in `[0, 1]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lambertian {
+    /// Hemispherical reflectance.
+    pub albedo: f64,
+}
+
+impl Model for Lambertian {
+    fn eval(&self, wo: &V3, wi: &V3) -> Mueller {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Mueller::zeros();
+        }
+        depolarizer(self.albedo * FRAC_1_PI * wi.z)
+    }
+
+    fn pdf(&self, wo: &V3, wi: &V3) -> f64 {
+        if wo.z <= 0.0 {
+            0.0
+        } else {
+            cosine_hemisphere_pdf(wi)
+        }
+    }
+
+    fn sample(&self, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
+        let wi = cosine_hemisphere([u[1], u[2]]);
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = cosine_hemisphere_pdf(&wi);
+        Some(BsdfSample {
+            wi,
+            weight: depolarizer(self.albedo),
+            pdf,
+            is_delta: false,
+            is_transmission: false,
+            eta: 1.0,
+        })
+    }
+
+    fn has_delta(&self) -> bool {
+        false
+    }
+
+    fn polarization(&self) -> Polarization {
+        Polarization::None
+    }
+}

@@ -1,0 +1,138 @@
+//! Polarized BSDFs: every material of the simulator returns Mueller matrices
+//! instead of spectra, following Mitsuba 3's recipe (Fresnel matrix in the s/p
+//! frame, then rotated into the implicit Stokes bases of the two directions).
+//!
+//! # Interface contract (shared with `polar-render`)
+//! - Directions are unit vectors in the local shading frame: `z` = shading
+//!   normal, `x` = tangent (anisotropy and sheet axis), `y = z × x`.
+//! - `wo` points from the surface toward the viewer (light leaves along `wo`);
+//!   `wi` points toward the light (light arrives travelling along `-wi`).
+//! - Every Mueller matrix maps incident Stokes vectors, expressed in the frame
+//!   with x axis `polar_optics::stokes_basis(&-wi)`, to outgoing Stokes vectors
+//!   in the frame with x axis `polar_optics::stokes_basis(&wo)`.
+//! - [`Bsdf::eval`] is `f(wo, wi) |cos θi|`; delta lobes are excluded from `eval`
+//!   and `pdf` and appear only in [`Bsdf::sample`].
+//! - Camera paths carry radiance: refraction includes the `1/η²` radiance
+//!   scaling, with `η = BsdfSample::eta = n(wi side) / n(wo side)`.
+//! - Opaque materials (conductor, plastic, Lambertian) are one-sided: zero unless
+//!   `wo.z > 0` and `wi.z > 0`. A renderer that wants two-sided opaque surfaces
+//!   flips the shading frame (z and y) toward `wo` before calling.
+
+mod conductor;
+mod dielectric;
+mod error;
+mod geometry;
+mod lambertian;
+mod material;
+pub mod microfacet;
+mod plastic;
+mod sheet;
+
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
+pub use error::Error;
+pub use lambertian::Lambertian;
+pub use material::{
+    Checkerboard, ConductorParams, DielectricParams, LambertianParams, Material, Metal,
+    PlasticParams, PolarizerParams, RetarderParams, Roughness, Texture,
+};
+pub use plastic::Plastic;
+pub use sheet::{Sheet, SheetKind};
+
+use nalgebra::Vector3;
+use polar_optics::Mueller;
+
+/// The cheapest exact light-transport model a BSDF needs, ordered
+/// `None < Linear < Full` so a scene needs the maximum over its materials.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Polarization {
+    /// Never polarizes and passes light on depolarized (only `M00` is non-zero):
+    /// scalar transport is exact.
+    None,
+    /// Creates or changes linear polarization but never couples `S3` with
+    /// `S0..S2` (`M[3][0..3] = M[0..3][3] = 0`): 3-component Stokes is exact.
+    Linear,
+    /// May create circular polarization or convert linear to circular
+    /// (conductors, total internal reflection, retarders): full 4×4 Mueller.
+    Full,
+}
+
+/// One sampled incident direction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Sampled direction toward the light (unit, local frame).
+    pub wi: Vector3<f64>,
+    /// `f |cos θi| / pdf` for a smooth lobe, or the delta lobe's Mueller matrix
+    /// divided by the probability of choosing it.
+    pub weight: Mueller,
+    /// Solid-angle density of `wi`; for a delta lobe the discrete probability of choosing it.
+    pub pdf: f64,
+    /// `wi` came from a delta (specular) lobe: skip MIS and light sampling for it.
+    pub is_delta: bool,
+    /// `wi` lies on the other side of the surface from `wo`.
+    pub is_transmission: bool,
+    /// Relative index crossed, `n(wi side) / n(wo side)`; 1 for reflection.
+    pub eta: f64,
+}
+
+/// A polarized BSDF at one surface point (a closed set, one `match` per method).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Bsdf {
+    /// Ideal depolarizing Lambertian reflector.
+    Lambertian(Lambertian),
+    /// Smooth or GGX-rough conductor with complex index.
+    Conductor(Conductor),
+    /// Smooth or GGX-rough dielectric interface (reflection and transmission).
+    Dielectric(Dielectric),
+    /// Polarized plastic as Mitsuba 3's `pplastic` (Baek et al. 2018).
+    Plastic(Plastic),
+    /// Thin pass-through linear polarizer or retarder.
+    Sheet(Sheet),
+}
+
+/// What every BSDF model provides; [`Bsdf`] dispatches to it.
+trait Model {
+    fn eval(&self, wo: &Vector3<f64>, wi: &Vector3<f64>) -> Mueller;
+    fn pdf(&self, wo: &Vector3<f64>, wi: &Vector3<f64>) -> f64;
+    fn sample(&self, wo: &Vector3<f64>, u: [f64; 3]) -> Option<BsdfSample>;
+    fn has_delta(&self) -> bool;
+    fn polarization(&self) -> Polarization;
+}
+
+impl Bsdf {
+    fn model(&self) -> &dyn Model {
+        match self {
+            Bsdf::Lambertian(b) => b,
+            Bsdf::Conductor(b) => b,
+            Bsdf::Dielectric(b) => b,
+            Bsdf::Plastic(b) => b,
+            Bsdf::Sheet(b) => b,
+        }
+    }
+
+    /// `f(wo, wi) |cos θi|` as a Mueller matrix (zero for delta lobes).
+    pub fn eval(&self, wo: &Vector3<f64>, wi: &Vector3<f64>) -> Mueller {
+        self.model().eval(wo, wi)
+    }
+
+    /// Solid-angle density with which [`Self::sample`] returns `wi` (0 for delta lobes).
+    pub fn pdf(&self, wo: &Vector3<f64>, wi: &Vector3<f64>) -> f64 {
+        self.model().pdf(wo, wi)
+    }
+
+    /// Samples `wi` given `wo` and three uniform numbers in `[0, 1)` (the first
+    /// picks a lobe where there are several). `None` when no light can arrive.
+    pub fn sample(&self, wo: &Vector3<f64>, u: [f64; 3]) -> Option<BsdfSample> {
+        self.model().sample(wo, u)
+    }
+
+    /// Whether some lobe is a delta (then light sampling cannot reach that lobe).
+    pub fn has_delta(&self) -> bool {
+        self.model().has_delta()
+    }
+
+    /// The cheapest exact transport model this BSDF needs.
+    pub fn polarization(&self) -> Polarization {
+        self.model().polarization()
+    }
+}

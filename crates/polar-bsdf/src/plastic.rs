@@ -1,0 +1,138 @@
+//! Polarized plastic, the model of Mitsuba 3's `pplastic` (Baek et al. 2018,
+//! "Simultaneous acquisition of polarimetric SVBRDF and normals"):
+//! - a specular lobe: GGX microfacet reflection with the polarized Fresnel matrix
+//!   of the dielectric coating (or a smooth mirror lobe when the roughness is 0,
+//!   an extension: Mitsuba's plugin is always rough);
+//! - a diffuse lobe: light refracts in (`T_in(θi)`), is depolarized by subsurface
+//!   scattering, and refracts out (`T_out(θo)`):
+//!   `M = T_out · D · T_in · albedo/π · cos θi` with `D = diag(1, 0, 0, 0)`; the
+//!   exit refraction gives the weak, 90°-rotated diffuse polarization that shape
+//!   from polarization relies on. Both transmissions are in flux units, as in Mitsuba.
+//!
+//! The two lobes are added (not energy conserving, as the original) and sampled
+//! as Mitsuba does: the specular lobe with probability `specular_prob`
+//! (`1 / (1 + mean albedo)`), the diffuse lobe by cosine sampling, and the
+//! weight of a non-delta sample is the full `eval / pdf` of the mixture.
+
+use crate::conductor::{microfacet_reflection, microfacet_reflection_pdf};
+use crate::geometry::{
+    V3, cosine_hemisphere, cosine_hemisphere_pdf, reflect, reflect_z, reflection, s_axis,
+    to_bsdf_bases,
+};
+use crate::microfacet::Ggx;
+use crate::{BsdfSample, Model, Polarization};
+use polar_optics::Mueller;
+use polar_optics::fresnel::fresnel_amplitudes;
+use std::f64::consts::FRAC_1_PI;
+
+/// Polarized plastic at one surface point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plastic {
+    /// Interior over exterior index of the coating.
+    pub eta: f64,
+    /// Microfacet distribution of the specular lobe; `None` for a smooth coating.
+    pub roughness: Option<Ggx>,
+    /// Diffuse reflectance (Mitsuba's `diffuse_reflectance`) at this point.
+    pub albedo: f64,
+    /// Probability of sampling the specular lobe, in `[0, 1]`.
+    pub specular_prob: f64,
+}
+
+impl Plastic {
+    /// The diffuse lobe `T_out(θo) · D · T_in(θi) · albedo cos θi / π`, in the BSDF bases.
+    fn diffuse(&self, wo: &V3, wi: &V3) -> Mueller {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Mueller::zeros();
+        }
+        let t_in = fresnel_amplitudes(wi.z, self.eta.into()).transmission_mueller();
+        // The internal direction that refracts out along wo.
+        let cos_inside = (1.0 - (1.0 - wo.z * wo.z) / (self.eta * self.eta))
+            .max(0.0)
+            .sqrt();
+        let t_out = fresnel_amplitudes(cos_inside, (1.0 / self.eta).into()).transmission_mueller();
+        let m = t_out.column(0) * t_in.row(0) * (self.albedo * wi.z * FRAC_1_PI);
+        let k_in = -wi;
+        to_bsdf_bases(
+            &m,
+            &k_in,
+            &s_axis(&V3::z(), &k_in),
+            wo,
+            &s_axis(&V3::z(), wo),
+        )
+    }
+
+    fn diffuse_prob(&self) -> f64 {
+        1.0 - self.specular_prob
+    }
+}
+
+impl Model for Plastic {
+    fn eval(&self, wo: &V3, wi: &V3) -> Mueller {
+        let diffuse = self.diffuse(wo, wi);
+        match &self.roughness {
+            Some(ggx) => diffuse + microfacet_reflection(ggx, self.eta.into(), wo, wi),
+            None => diffuse,
+        }
+    }
+
+    fn pdf(&self, wo: &V3, wi: &V3) -> f64 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let specular = self
+            .roughness
+            .as_ref()
+            .map_or(0.0, |ggx| microfacet_reflection_pdf(ggx, wo, wi));
+        self.specular_prob * specular + self.diffuse_prob() * cosine_hemisphere_pdf(wi)
+    }
+
+    fn sample(&self, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = match (&self.roughness, u[0] < self.specular_prob) {
+            (None, true) => {
+                let wi = reflect_z(wo);
+                let weight = reflection(self.eta.into(), &V3::z(), wo, &wi) / self.specular_prob;
+                let pdf = self.specular_prob;
+                return Some(BsdfSample {
+                    wi,
+                    weight,
+                    pdf,
+                    is_delta: true,
+                    is_transmission: false,
+                    eta: 1.0,
+                });
+            }
+            (Some(ggx), true) => reflect(wo, &ggx.sample_visible(wo, [u[1], u[2]])),
+            (_, false) => cosine_hemisphere([u[1], u[2]]),
+        };
+        let pdf = self.pdf(wo, &wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        let weight = self.eval(wo, &wi) / pdf;
+        Some(BsdfSample {
+            wi,
+            weight,
+            pdf,
+            is_delta: false,
+            is_transmission: false,
+            eta: 1.0,
+        })
+    }
+
+    fn has_delta(&self) -> bool {
+        self.roughness.is_none()
+    }
+
+    /// Real Fresnel amplitudes from outside (`η ≥ 1`) never couple S3; a coating
+    /// thinner than the outside medium can totally reflect and so needs `Full`.
+    fn polarization(&self) -> Polarization {
+        if self.eta >= 1.0 {
+            Polarization::Linear
+        } else {
+            Polarization::Full
+        }
+    }
+}
