@@ -15,8 +15,9 @@ pub(crate) fn band_rows(ry: usize) -> usize {
     BAND_ROWS.max(4 * ry)
 }
 
-/// The kernel of `cv::getGaussianKernel(ksize, sigma)`: for `sigma <= 0` and `ksize` 1, 3,
-/// 5 or 7 OpenCV's fixed binomial-like tables; otherwise `exp(-x^2 / (2 sigma^2))` with
+/// The kernel of `cv::getGaussianKernel(ksize, sigma)` as OpenCV 5 builds it: for
+/// `sigma <= 0` and `ksize` 1, 3, 5, 7 or 9 its fixed tables (the 9-tap one is
+/// `[4, 13, 30, 51, 60, 51, 30, 13, 4] / 256`, new in OpenCV 5); otherwise `exp(-x^2 / (2 sigma^2))` with
 /// `x = i - (ksize-1)/2` and `sigma = 0.3 ((ksize-1)/2 - 1) + 0.8` when `sigma <= 0`,
 /// normalised to sum 1 in double precision and rounded to `f32`.
 pub fn gaussian_kernel(ksize: usize, sigma: f64) -> Result<Vec<f32>, Error> {
@@ -26,16 +27,17 @@ pub fn gaussian_kernel(ksize: usize, sigma: f64) -> Result<Vec<f32>, Error> {
             reason: "must be odd and positive",
         });
     }
-    const FIXED: [&[f64]; 4] = [
+    const FIXED: [&[f64]; 5] = [
         &[1.0],
         &[0.25, 0.5, 0.25],
         &[0.0625, 0.25, 0.375, 0.25, 0.0625],
         &[
             0.03125, 0.109375, 0.21875, 0.28125, 0.21875, 0.109375, 0.03125,
         ],
+        &[4.0, 13.0, 30.0, 51.0, 60.0, 51.0, 30.0, 13.0, 4.0],
     ];
     let half = (ksize as f64 - 1.0) * 0.5;
-    let raw: Vec<f64> = if sigma <= 0.0 && ksize <= 7 {
+    let raw: Vec<f64> = if sigma <= 0.0 && ksize <= 9 {
         FIXED[ksize / 2].to_vec()
     } else {
         let s = if sigma > 0.0 {
@@ -286,13 +288,14 @@ mod tests {
     #[test]
     fn gaussian_kernel_fixed_tables_and_formula() {
         assert_eq!(gaussian_kernel(3, 0.0).unwrap(), [0.25, 0.5, 0.25]);
-        let k = gaussian_kernel(9, 0.0).unwrap();
-        // sigma = 0.3 * (4 - 1) + 0.8 = 1.7; the centre tap of a normalised Gaussian.
-        let s = 1.7f64;
-        let norm: f64 = (-4..=4)
+        assert_eq!(gaussian_kernel(9, 0.0).unwrap()[4], 60.0 / 256.0);
+        let k = gaussian_kernel(11, 0.0).unwrap();
+        // sigma = 0.3 * (5 - 1) + 0.8 = 2.0; the centre tap of a normalised Gaussian.
+        let s = 2.0f64;
+        let norm: f64 = (-5..=5)
             .map(|x| (-(x * x) as f64 / (2.0 * s * s)).exp())
             .sum();
-        assert!((f64::from(k[4]) - 1.0 / norm).abs() < 1e-7);
+        assert!((f64::from(k[5]) - 1.0 / norm).abs() < 1e-7);
         assert!(gaussian_kernel(4, 1.0).is_err());
     }
 
