@@ -1,0 +1,80 @@
+//! The one error type of the crate: every variant names the file, sample or argument at fault.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong while making, resuming or merging a dataset.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file or directory operation failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or directory involved.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The suite file cannot be parsed or breaks a rule (caught before any rendering).
+    #[error("suite {path}: {message}")]
+    Suite {
+        /// The suite file.
+        path: PathBuf,
+        /// What is wrong and where.
+        message: String,
+    },
+    /// A `--shard` argument that is not `K/N` with `1 <= K <= N`.
+    #[error("bad shard '{0}': expected K/N with 1 <= K <= N, e.g. --shard 2/8")]
+    Shard(String),
+    /// The output directory cannot be created or written.
+    #[error("output directory {path} is not writable: {source}")]
+    OutputNotWritable {
+        /// The output directory.
+        path: PathBuf,
+        /// Why the probe write failed.
+        source: std::io::Error,
+    },
+    /// The output directory already holds a run of another suite, size or shard.
+    #[error("output directory {path} holds a different run ({reason}); use a new directory")]
+    RunMismatch {
+        /// The output directory.
+        path: PathBuf,
+        /// Which recorded setting differs.
+        reason: String,
+    },
+    /// A file's SHA-256 differs from the one recorded in the manifest.
+    #[error("{path}: checksum mismatch (manifest {expected}, file {actual})")]
+    Checksum {
+        /// The file whose content changed.
+        path: PathBuf,
+        /// The checksum in the manifest.
+        expected: String,
+        /// The checksum of the file now.
+        actual: String,
+    },
+    /// Shards that cannot be joined into one dataset.
+    #[error("merge: {0}")]
+    Merge(String),
+    /// The per-sample work (rendering, sensor, writing) failed for one sample.
+    #[error("sample {id}: {message}")]
+    Sample {
+        /// The sample id.
+        id: String,
+        /// What failed.
+        message: String,
+    },
+    /// A JSON file of the dataset cannot be read or written.
+    #[error("{path}: {message}")]
+    Json {
+        /// The JSON file.
+        path: PathBuf,
+        /// The parser's message.
+        message: String,
+    },
+}
+
+impl Error {
+    /// Wraps an I/O error with the path it concerns.
+    pub fn io(path: impl Into<PathBuf>) -> impl FnOnce(std::io::Error) -> Error {
+        let path = path.into();
+        move |source| Error::Io { path, source }
+    }
+}

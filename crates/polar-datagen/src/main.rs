@@ -1,0 +1,3 @@
+//! `polar-datagen`: command-line front end (see `--help`).
+
+fn main() {}

@@ -1,0 +1,297 @@
+//! The dataset on disk: sample directories committed atomically (write into `.staging/`, then
+//! rename), `manifest.jsonl` (one line per committed sample), `run.json` (what run this is)
+//! and SHA-256 checksums that tie the manifest to the files.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::Error;
+use crate::params::SampleParams;
+
+/// Name of the manifest file in a dataset directory.
+pub const MANIFEST: &str = "manifest.jsonl";
+/// Name of the run record in a dataset directory.
+pub const RUN_RECORD: &str = "run.json";
+/// Copy of the suite file in a dataset directory (merge re-derives the expected ids from it).
+pub const SUITE_COPY: &str = "suite.toml";
+/// Hidden directory where samples are written before the atomic rename.
+pub const STAGING: &str = ".staging";
+
+/// One manifest line: a committed sample.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ManifestEntry {
+    /// Sample id = directory name.
+    pub id: String,
+    /// Sample seed.
+    pub seed: u64,
+    /// Every parameter of the sample.
+    pub params: SampleParams,
+    /// SHA-256 (hex) of every file, by path relative to the sample directory ('/' separated).
+    pub files: BTreeMap<String, String>,
+    /// Light-transport model the renderer used.
+    pub model: String,
+    /// Wall-clock seconds: render and the whole sample.
+    pub timings: Timings,
+}
+
+/// Wall-clock timings of one sample (vary run to run; everything else is deterministic).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Timings {
+    /// Seconds spent in the renderer.
+    pub render_seconds: f64,
+    /// Seconds for the whole sample: render, sensor, encode, checksum, commit.
+    pub total_seconds: f64,
+}
+
+/// What run a dataset directory holds; a resumed run must match it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Suite name.
+    pub suite: String,
+    /// SHA-256 of the suite file text.
+    pub suite_sha256: String,
+    /// `ci` or `full`.
+    pub size: crate::suite::SizeName,
+    /// Shard index, 1-based.
+    pub shard: u32,
+    /// Number of shards.
+    pub shards: u32,
+    /// Number of samples this shard is responsible for.
+    pub expected: usize,
+}
+
+/// Hex SHA-256 of bytes.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Hex SHA-256 of a file, streamed.
+pub fn sha256_file(path: &Path) -> Result<String, Error> {
+    let mut file = fs::File::open(path).map_err(Error::io(path))?;
+    let mut hasher = Sha256::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = file.read(&mut buf).map_err(Error::io(path))?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    Ok(hex(&hasher.finalize()))
+}
+
+/// Checksums of every file under `dir`, keyed by '/'-separated relative path, sorted.
+pub fn checksum_dir(dir: &Path) -> Result<BTreeMap<String, String>, Error> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_owned()];
+    while let Some(d) = stack.pop() {
+        for entry in fs::read_dir(&d).map_err(Error::io(&d))? {
+            let path = entry.map_err(Error::io(&d))?.path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let rel = path.strip_prefix(dir).unwrap_or(&path);
+                let key = rel
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy())
+                    .collect::<Vec<_>>()
+                    .join("/");
+                out.insert(key, sha256_file(&path)?);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Checks every file of an entry against its checksum; the error names the first bad file.
+pub fn verify_entry(dataset: &Path, entry: &ManifestEntry) -> Result<(), Error> {
+    let dir = dataset.join(&entry.id);
+    for (rel, expected) in &entry.files {
+        let path = dir.join(rel);
+        let actual = sha256_file(&path)?;
+        if &actual != expected {
+            return Err(Error::Checksum {
+                path,
+                expected: expected.clone(),
+                actual,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to `path` atomically: a sibling temporary file, fsync, rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let tmp = path.with_extension("tmp");
+    let mut f = fs::File::create(&tmp).map_err(Error::io(&tmp))?;
+    f.write_all(bytes).map_err(Error::io(&tmp))?;
+    f.sync_all().map_err(Error::io(&tmp))?;
+    fs::rename(&tmp, path).map_err(Error::io(path))
+}
+
+/// Reads a JSON file.
+pub fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, Error> {
+    let text = fs::read_to_string(path).map_err(Error::io(path))?;
+    serde_json::from_str(&text).map_err(|e| Error::Json {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })
+}
+
+/// Writes a JSON file atomically, pretty-printed.
+pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), Error> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| Error::Json {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    write_atomic(path, format!("{text}\n").as_bytes())
+}
+
+/// Creates `dir` if needed and proves it writable by creating and removing a probe file.
+pub fn ensure_writable(dir: &Path) -> Result<(), Error> {
+    let fail = |source| Error::OutputNotWritable {
+        path: dir.to_owned(),
+        source,
+    };
+    fs::create_dir_all(dir).map_err(fail)?;
+    let probe = dir.join(".write-probe");
+    fs::write(&probe, b"probe").map_err(fail)?;
+    fs::remove_file(&probe).map_err(fail)
+}
+
+/// Reads the manifest's complete lines. A torn last line (the run was killed while appending)
+/// is dropped; a bad line elsewhere is an error naming it.
+pub fn read_manifest(dataset: &Path) -> Result<Vec<ManifestEntry>, Error> {
+    let path = dataset.join(MANIFEST);
+    let text = match fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(Error::Io { path, source: e }),
+    };
+    let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    let mut out = Vec::with_capacity(lines.len());
+    for (i, line) in lines.iter().enumerate() {
+        match serde_json::from_str(line) {
+            Ok(e) => out.push(e),
+            Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => break,
+            Err(e) => {
+                return Err(Error::Json {
+                    path,
+                    message: format!("line {}: {e}", i + 1),
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Rewrites the whole manifest atomically, entries sorted by id.
+pub fn write_manifest(dataset: &Path, entries: &[ManifestEntry]) -> Result<(), Error> {
+    let mut sorted: Vec<&ManifestEntry> = entries.iter().collect();
+    sorted.sort_by(|a, b| a.id.cmp(&b.id));
+    let mut text = String::new();
+    for e in sorted {
+        text.push_str(&manifest_line(dataset, e)?);
+    }
+    write_atomic(&dataset.join(MANIFEST), text.as_bytes())
+}
+
+fn manifest_line(dataset: &Path, e: &ManifestEntry) -> Result<String, Error> {
+    let line = serde_json::to_string(e).map_err(|err| Error::Json {
+        path: dataset.join(MANIFEST),
+        message: err.to_string(),
+    })?;
+    Ok(format!("{line}\n"))
+}
+
+/// Appends one entry to the manifest with a single write, then fsyncs it.
+pub fn append_manifest(dataset: &Path, entry: &ManifestEntry) -> Result<(), Error> {
+    let path = dataset.join(MANIFEST);
+    let line = manifest_line(dataset, entry)?;
+    let mut f = fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .map_err(Error::io(&path))?;
+    f.write_all(line.as_bytes()).map_err(Error::io(&path))?;
+    f.sync_data().map_err(Error::io(&path))
+}
+
+/// A fresh, empty staging directory for one sample.
+pub fn staging_dir(dataset: &Path, id: &str) -> Result<PathBuf, Error> {
+    let dir = dataset.join(STAGING).join(id);
+    if dir.exists() {
+        fs::remove_dir_all(&dir).map_err(Error::io(&dir))?;
+    }
+    fs::create_dir_all(&dir).map_err(Error::io(&dir))?;
+    Ok(dir)
+}
+
+/// Moves a finished staging directory to `<dataset>/<id>` in one rename.
+pub fn commit_dir(dataset: &Path, staged: &Path, id: &str) -> Result<PathBuf, Error> {
+    let target = dataset.join(id);
+    if target.exists() {
+        fs::remove_dir_all(&target).map_err(Error::io(&target))?;
+    }
+    fs::rename(staged, &target).map_err(Error::io(&target))?;
+    Ok(target)
+}
+
+/// Recursively copies a directory (merge copies into staging, then commits with a rename).
+pub fn copy_dir(from: &Path, to: &Path) -> Result<(), Error> {
+    fs::create_dir_all(to).map_err(Error::io(to))?;
+    for entry in fs::read_dir(from).map_err(Error::io(from))? {
+        let path = entry.map_err(Error::io(from))?.path();
+        let dest = to.join(path.file_name().unwrap_or_default());
+        if path.is_dir() {
+            copy_dir(&path, &dest)?;
+        } else {
+            fs::copy(&path, &dest).map_err(Error::io(&path))?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sha256_matches_the_fips_test_vector() {
+        // FIPS 180-2 example "abc".
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+    }
+
+    #[test]
+    fn torn_last_manifest_line_is_dropped_but_bad_middle_line_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        fs::write(dir.path().join(MANIFEST), "{\"id\":").unwrap();
+        assert!(read_manifest(dir.path()).unwrap().is_empty());
+        fs::write(dir.path().join(MANIFEST), "garbage\n{}\n").unwrap();
+        let e = read_manifest(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("line 1"), "{e}");
+    }
+
+    #[test]
+    fn checksum_dir_covers_nested_files() {
+        let dir = tempfile::tempdir().unwrap();
+        fs::create_dir_all(dir.path().join("gt")).unwrap();
+        fs::write(dir.path().join("gt/a.bin"), b"abc").unwrap();
+        fs::write(dir.path().join("meta.json"), b"{}").unwrap();
+        let sums = checksum_dir(dir.path()).unwrap();
+        assert_eq!(sums.keys().collect::<Vec<_>>(), ["gt/a.bin", "meta.json"]);
+        assert_eq!(sums["gt/a.bin"], sha256_hex(b"abc"));
+    }
+}

@@ -1,0 +1,670 @@
+//! Suite files: a versioned TOML description of a dataset (families, sizes, parameter ranges,
+//! sensor noise levels), parsed and validated before any rendering starts.
+//!
+//! The format is documented in `datasets-synth/suites/README.md`; [`param_specs`] is the
+//! single table of parameter names, default ranges and physical limits.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::Error;
+
+/// The suite file format version this crate reads.
+pub const SUITE_VERSION: u32 = 1;
+
+/// A whole dataset description.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Suite {
+    /// Format version, must be [`SUITE_VERSION`].
+    pub version: u32,
+    /// Short name, used in the run record.
+    pub name: String,
+    /// Free text for people.
+    #[serde(default)]
+    pub description: String,
+    /// Master seed: every sample seed derives from it, the family name and the sample index.
+    pub seed: u64,
+    /// Sensor noise levels, cycled over the samples of each family.
+    #[serde(rename = "noise")]
+    pub noise: Vec<NoiseLevel>,
+    /// The families of samples, in order.
+    #[serde(rename = "family")]
+    pub families: Vec<Family>,
+}
+
+/// One sensor noise level (photon shot noise, read noise, quantisation), as in EMVA 1288.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseLevel {
+    /// Name referred to by families, e.g. `clean` or `realistic`.
+    pub name: String,
+    /// Electrons collected at S0 = 1 behind an open pixel; 0 turns shot noise off.
+    pub full_well_e: f64,
+    /// Gaussian read noise, electrons RMS.
+    pub read_noise_e: f64,
+    /// ADC bit depth of the raw mosaic (8..=16).
+    pub bits: u8,
+}
+
+/// What a family of samples is for; decides its parameters and scene layout.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FamilyKind {
+    /// Shape from polarization: procedural shapes of varied index, roughness and albedo.
+    Shape,
+    /// Material classification: metals and dielectrics, rough and smooth, textured.
+    Material,
+    /// Transparent objects: glass of several shapes and thicknesses over textured backgrounds.
+    Transparent,
+    /// Haze: needs participating media (issue 5), which the renderer does not have yet.
+    Haze,
+}
+
+impl FamilyKind {
+    /// Why this kind cannot be rendered yet, if it cannot.
+    pub fn pending_reason(self) -> Option<&'static str> {
+        match self {
+            FamilyKind::Haze => Some(
+                "needs participating-media support in the renderer (issue 5), not yet built; skipped",
+            ),
+            _ => None,
+        }
+    }
+
+    /// The snake_case name used in suite files.
+    pub fn name(self) -> &'static str {
+        match self {
+            FamilyKind::Shape => "shape",
+            FamilyKind::Material => "material",
+            FamilyKind::Transparent => "transparent",
+            FamilyKind::Haze => "haze",
+        }
+    }
+}
+
+/// Which of a family's two sizes to make.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum SizeName {
+    /// A few tiny samples: seconds on a laptop, for CI.
+    Ci,
+    /// The real dataset.
+    Full,
+}
+
+/// Image size, sample count and samples per pixel for one size of a family.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SizeSpec {
+    /// Number of samples.
+    pub count: u32,
+    /// Image width in pixels (even: the mosaic has 2x2 super-pixels).
+    pub width: u32,
+    /// Image height in pixels (even).
+    pub height: u32,
+    /// Path-tracing samples per pixel.
+    pub spp: u32,
+}
+
+/// A family: one kind of sample with its sizes, ranges and choices.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Family {
+    /// Unique name, the prefix of its sample ids.
+    pub name: String,
+    /// What the family is for.
+    pub kind: FamilyKind,
+    /// Names of the noise levels to cycle through; empty means all of the suite's.
+    #[serde(default)]
+    pub noise: Vec<String>,
+    /// The CI size.
+    pub ci: SizeSpec,
+    /// The full size.
+    pub full: SizeSpec,
+    /// Overrides of numeric ranges, `key = [min, max]`; see [`param_specs`].
+    #[serde(default)]
+    pub ranges: BTreeMap<String, [f64; 2]>,
+    /// Overrides of choice lists, `key = ["a", "b"]`; see [`choice_specs`].
+    #[serde(default)]
+    pub choices: BTreeMap<String, Vec<String>>,
+}
+
+impl Family {
+    /// The size spec for `size`.
+    pub fn size(&self, size: SizeName) -> SizeSpec {
+        match size {
+            SizeName::Ci => self.ci,
+            SizeName::Full => self.full,
+        }
+    }
+
+    /// The effective `[min, max]` for `key`: the suite's override or the documented default.
+    pub fn range(&self, key: &str) -> [f64; 2] {
+        if let Some(r) = self.ranges.get(key) {
+            return *r;
+        }
+        param_specs(self.kind)
+            .iter()
+            .find(|s| s.key == key)
+            .map_or([0.0, 0.0], |s| s.default)
+    }
+
+    /// The effective choice list for `key`: the suite's override or the documented default.
+    pub fn choices(&self, key: &str) -> Vec<String> {
+        if let Some(c) = self.choices.get(key) {
+            return c.clone();
+        }
+        choice_specs(self.kind)
+            .iter()
+            .find(|s| s.key == key)
+            .map_or_else(Vec::new, |s| {
+                s.default.iter().map(|v| v.to_string()).collect()
+            })
+    }
+}
+
+/// A numeric parameter: name, default range, physical limits and meaning.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamSpec {
+    /// Key in `[family.ranges]` and in the recorded parameters.
+    pub key: &'static str,
+    /// Default `[min, max]` drawn uniformly.
+    pub default: [f64; 2],
+    /// Hard limits: a range outside is rejected as physically implausible.
+    pub limits: [f64; 2],
+    /// What it means, with unit.
+    pub doc: &'static str,
+}
+
+/// A categorical parameter: name, allowed values and default list.
+#[derive(Clone, Copy, Debug)]
+pub struct ChoiceSpec {
+    /// Key in `[family.choices]`.
+    pub key: &'static str,
+    /// Values a suite may list.
+    pub allowed: &'static [&'static str],
+    /// Default list, drawn uniformly.
+    pub default: &'static [&'static str],
+    /// What it means.
+    pub doc: &'static str,
+}
+
+const fn p(key: &'static str, default: [f64; 2], limits: [f64; 2], doc: &'static str) -> ParamSpec {
+    ParamSpec {
+        key,
+        default,
+        limits,
+        doc,
+    }
+}
+
+const COMMON: &[ParamSpec] = &[
+    p(
+        "camera_distance",
+        [3.0, 4.5],
+        [0.5, 100.0],
+        "camera distance to the scene centre, m",
+    ),
+    p(
+        "camera_elevation_deg",
+        [5.0, 35.0],
+        [-80.0, 80.0],
+        "camera elevation above the ground plane, degrees",
+    ),
+    p(
+        "fov_deg",
+        [30.0, 40.0],
+        [5.0, 120.0],
+        "vertical field of view, degrees",
+    ),
+    p(
+        "light_elevation_deg",
+        [20.0, 75.0],
+        [0.0, 90.0],
+        "key light elevation, degrees",
+    ),
+    p(
+        "light_azimuth_deg",
+        [0.0, 360.0],
+        [0.0, 360.0],
+        "key light azimuth, degrees",
+    ),
+    p(
+        "light_intensity",
+        [2.0, 5.0],
+        [0.01, 1000.0],
+        "key light radiance scale, relative",
+    ),
+    p(
+        "ambient",
+        [0.05, 0.3],
+        [0.0, 10.0],
+        "uniform environment radiance, relative",
+    ),
+];
+
+const SHAPE: &[ParamSpec] = &[
+    p(
+        "objects",
+        [1.0, 3.0],
+        [1.0, 8.0],
+        "number of objects (integer)",
+    ),
+    p(
+        "ior",
+        [1.3, 1.8],
+        [1.0, 3.0],
+        "dielectric index of refraction (plastics 1.45-1.6, gems up to 2.4)",
+    ),
+    p("roughness", [0.0, 0.35], [0.0, 1.0], "GGX roughness alpha"),
+    p(
+        "albedo",
+        [0.05, 0.9],
+        [0.0, 1.0],
+        "diffuse albedo under the specular coat",
+    ),
+    p(
+        "superquadric_exponent",
+        [0.3, 2.5],
+        [0.1, 4.0],
+        "superquadric exponents e1, e2 (1 = sphere)",
+    ),
+    p(
+        "blob_amplitude",
+        [0.05, 0.25],
+        [0.0, 0.5],
+        "radial bump amplitude of blobs, fraction of radius",
+    ),
+    p(
+        "blob_frequency",
+        [2.0, 5.0],
+        [1.0, 12.0],
+        "angular frequency of blob bumps",
+    ),
+    p(
+        "torus_minor_ratio",
+        [0.2, 0.45],
+        [0.05, 0.9],
+        "torus tube radius / ring radius",
+    ),
+    p(
+        "extrusion_sides",
+        [3.0, 8.0],
+        [3.0, 32.0],
+        "sides of the extruded star/polygon (integer)",
+    ),
+    p(
+        "extrusion_depth",
+        [0.3, 1.2],
+        [0.05, 4.0],
+        "extrusion depth, fraction of size",
+    ),
+    p("object_size", [0.5, 0.9], [0.05, 5.0], "object radius, m"),
+];
+
+const MATERIAL: &[ParamSpec] = &[
+    p(
+        "objects",
+        [2.0, 4.0],
+        [1.0, 8.0],
+        "number of objects (integer)",
+    ),
+    p(
+        "ior",
+        [1.3, 1.8],
+        [1.0, 3.0],
+        "dielectric index of refraction",
+    ),
+    p("roughness", [0.0, 0.5], [0.0, 1.0], "GGX roughness alpha"),
+    p("albedo", [0.05, 0.9], [0.0, 1.0], "diffuse albedo"),
+    p(
+        "texture_scale",
+        [2.0, 12.0],
+        [1.0, 64.0],
+        "checker/stripe repetitions across an object",
+    ),
+    p("object_size", [0.4, 0.7], [0.05, 5.0], "object radius, m"),
+];
+
+const TRANSPARENT: &[ParamSpec] = &[
+    p(
+        "objects",
+        [1.0, 2.0],
+        [1.0, 8.0],
+        "number of glass objects (integer)",
+    ),
+    p(
+        "glass_ior",
+        [1.45, 1.6],
+        [1.0, 2.5],
+        "glass index of refraction (fused silica 1.46, crown 1.52, flint 1.6)",
+    ),
+    p(
+        "glass_roughness",
+        [0.0, 0.05],
+        [0.0, 1.0],
+        "GGX roughness of the glass surface",
+    ),
+    p(
+        "thickness",
+        [0.05, 0.4],
+        [0.005, 2.0],
+        "slab thickness / shell thickness, m",
+    ),
+    p(
+        "texture_scale",
+        [4.0, 16.0],
+        [1.0, 64.0],
+        "background pattern repetitions",
+    ),
+    p("object_size", [0.5, 0.9], [0.05, 5.0], "object radius, m"),
+];
+
+const HAZE: &[ParamSpec] = &[
+    p(
+        "density",
+        [0.01, 0.3],
+        [0.0, 10.0],
+        "extinction coefficient, 1/m",
+    ),
+    p(
+        "sun_elevation_deg",
+        [5.0, 60.0],
+        [0.0, 90.0],
+        "sun elevation, degrees",
+    ),
+    p(
+        "scene_depth",
+        [20.0, 200.0],
+        [1.0, 10000.0],
+        "depth of the scene, m",
+    ),
+];
+
+/// The numeric parameters of a kind: common camera/light ones, then the kind's own.
+pub fn param_specs(kind: FamilyKind) -> Vec<ParamSpec> {
+    let own = match kind {
+        FamilyKind::Shape => SHAPE,
+        FamilyKind::Material => MATERIAL,
+        FamilyKind::Transparent => TRANSPARENT,
+        FamilyKind::Haze => HAZE,
+    };
+    COMMON.iter().chain(own).copied().collect()
+}
+
+const SHAPES: &[&str] = &["sphere", "superquadric", "blob", "torus", "extrusion"];
+const GLASS_SHAPES: &[&str] = &["sphere", "slab", "torus", "extrusion"];
+const MATERIALS: &[&str] = &["dielectric", "metal", "textured"];
+const METALS: &[&str] = &["gold", "silver", "aluminium", "copper"];
+const BACKGROUNDS: &[&str] = &["checker", "stripes"];
+
+/// The categorical parameters of a kind.
+pub fn choice_specs(kind: FamilyKind) -> &'static [ChoiceSpec] {
+    const fn c(
+        key: &'static str,
+        allowed: &'static [&'static str],
+        doc: &'static str,
+    ) -> ChoiceSpec {
+        ChoiceSpec {
+            key,
+            allowed,
+            default: allowed,
+            doc,
+        }
+    }
+    const SHAPE_C: &[ChoiceSpec] = &[c("shape", SHAPES, "procedural shape of each object")];
+    const MATERIAL_C: &[ChoiceSpec] = &[
+        c("shape", SHAPES, "procedural shape of each object"),
+        c("material", MATERIALS, "material class of each object"),
+        c(
+            "metal",
+            METALS,
+            "metal of `metal` objects (complex index at 550 nm)",
+        ),
+    ];
+    const TRANSPARENT_C: &[ChoiceSpec] = &[
+        c("shape", GLASS_SHAPES, "shape of each glass object"),
+        c("background", BACKGROUNDS, "pattern of the background plane"),
+    ];
+    match kind {
+        FamilyKind::Shape => SHAPE_C,
+        FamilyKind::Material => MATERIAL_C,
+        FamilyKind::Transparent => TRANSPARENT_C,
+        FamilyKind::Haze => &[],
+    }
+}
+
+impl Suite {
+    /// Reads and validates a suite file; all errors name the file.
+    pub fn load(path: &Path) -> Result<Suite, Error> {
+        let text = std::fs::read_to_string(path).map_err(Error::io(path))?;
+        Suite::parse(&text).map_err(|message| Error::Suite {
+            path: path.to_owned(),
+            message,
+        })
+    }
+
+    /// Parses and validates suite text; the error message says what is wrong and where.
+    pub fn parse(text: &str) -> Result<Suite, String> {
+        let suite: Suite = toml::from_str(text).map_err(|e| e.to_string())?;
+        suite.validate()?;
+        Ok(suite)
+    }
+
+    /// Checks every rule the TOML types cannot express.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.version != SUITE_VERSION {
+            return Err(format!(
+                "version = {} is not supported (expected {SUITE_VERSION})",
+                self.version
+            ));
+        }
+        if self.noise.is_empty() {
+            return Err("needs at least one [[noise]] level".into());
+        }
+        for (i, n) in self.noise.iter().enumerate() {
+            validate_noise(n).map_err(|m| format!("[[noise]] #{} '{}': {m}", i + 1, n.name))?;
+            if self.noise[..i].iter().any(|o| o.name == n.name) {
+                return Err(format!("noise level '{}' is defined twice", n.name));
+            }
+        }
+        if self.families.is_empty() {
+            return Err("needs at least one [[family]]".into());
+        }
+        for (i, f) in self.families.iter().enumerate() {
+            self.validate_family(f)
+                .map_err(|m| format!("family '{}': {m}", f.name))?;
+            if self.families[..i].iter().any(|o| o.name == f.name) {
+                return Err(format!("family name '{}' is used twice", f.name));
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_family(&self, f: &Family) -> Result<(), String> {
+        let name_ok = !f.name.is_empty()
+            && f.name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+        if !name_ok {
+            return Err("name must be non-empty ASCII letters, digits, '_' or '-'".into());
+        }
+        for (label, s) in [("ci", f.ci), ("full", f.full)] {
+            validate_size(s).map_err(|m| format!("[{label}] {m}"))?;
+        }
+        for n in &f.noise {
+            if !self.noise.iter().any(|l| &l.name == n) {
+                return Err(format!("noise level '{n}' is not defined in [[noise]]"));
+            }
+        }
+        let specs = param_specs(f.kind);
+        for (key, [lo, hi]) in &f.ranges {
+            let Some(spec) = specs.iter().find(|s| s.key == key) else {
+                let known: Vec<_> = specs.iter().map(|s| s.key).collect();
+                return Err(format!(
+                    "unknown range '{key}' for kind {}; known: {}",
+                    f.kind.name(),
+                    known.join(", ")
+                ));
+            };
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                return Err(format!(
+                    "range {key} = [{lo}, {hi}] must be finite with min <= max"
+                ));
+            }
+            let [a, b] = spec.limits;
+            if *lo < a || *hi > b {
+                return Err(format!(
+                    "range {key} = [{lo}, {hi}] leaves the physically plausible limits [{a}, {b}] ({})",
+                    spec.doc
+                ));
+            }
+        }
+        let cspecs = choice_specs(f.kind);
+        for (key, values) in &f.choices {
+            let Some(spec) = cspecs.iter().find(|s| s.key == key) else {
+                let known: Vec<_> = cspecs.iter().map(|s| s.key).collect();
+                return Err(format!(
+                    "unknown choice '{key}' for kind {}; known: {}",
+                    f.kind.name(),
+                    known.join(", ")
+                ));
+            };
+            if values.is_empty() {
+                return Err(format!("choice {key} must list at least one value"));
+            }
+            if let Some(bad) = values.iter().find(|v| !spec.allowed.contains(&v.as_str())) {
+                return Err(format!(
+                    "choice {key} has unknown value '{bad}'; allowed: {}",
+                    spec.allowed.join(", ")
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The noise levels a family cycles through, in suite order.
+    pub fn noise_for(&self, family: &Family) -> Vec<&NoiseLevel> {
+        self.noise
+            .iter()
+            .filter(|l| family.noise.is_empty() || family.noise.contains(&l.name))
+            .collect()
+    }
+}
+
+fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
+    if !(n.full_well_e.is_finite() && n.full_well_e >= 0.0) {
+        return Err(format!("full_well_e = {} must be >= 0", n.full_well_e));
+    }
+    if !(n.read_noise_e.is_finite() && n.read_noise_e >= 0.0) {
+        return Err(format!("read_noise_e = {} must be >= 0", n.read_noise_e));
+    }
+    if !(8..=16).contains(&n.bits) {
+        return Err(format!("bits = {} must be in 8..=16", n.bits));
+    }
+    Ok(())
+}
+
+fn validate_size(s: SizeSpec) -> Result<(), String> {
+    if s.width < 2 || s.height < 2 || !s.width.is_multiple_of(2) || !s.height.is_multiple_of(2) {
+        return Err(format!(
+            "width x height = {}x{} must be even and >= 2 (2x2 polarizer super-pixels)",
+            s.width, s.height
+        ));
+    }
+    if s.width > 16384 || s.height > 16384 {
+        return Err(format!(
+            "width x height = {}x{} exceeds 16384",
+            s.width, s.height
+        ));
+    }
+    if s.spp == 0 {
+        return Err("spp must be >= 1".into());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    pub(crate) const MINI: &str = r#"
+version = 1
+name = "mini"
+seed = 7
+[[noise]]
+name = "clean"
+full_well_e = 0
+read_noise_e = 0
+bits = 16
+[[family]]
+name = "sfp"
+kind = "shape"
+ci = { count = 3, width = 8, height = 8, spp = 1 }
+full = { count = 10, width = 64, height = 64, spp = 16 }
+ranges = { ior = [1.4, 1.6] }
+"#;
+
+    #[test]
+    fn mini_suite_parses_with_overrides_and_defaults() {
+        let s = Suite::parse(MINI).unwrap();
+        let f = &s.families[0];
+        assert_eq!(f.range("ior"), [1.4, 1.6]);
+        assert_eq!(f.range("roughness"), [0.0, 0.35]);
+        assert_eq!(f.choices("shape").len(), SHAPES.len());
+    }
+
+    fn err_of(text: &str) -> String {
+        Suite::parse(text).unwrap_err()
+    }
+
+    #[test]
+    fn ior_below_one_is_rejected_with_limits() {
+        let e = err_of(&MINI.replace("[1.4, 1.6]", "[0.5, 1.6]"));
+        assert!(
+            e.contains("family 'sfp'") && e.contains("ior") && e.contains("[1, 3]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn unknown_range_key_lists_known_keys() {
+        let e = err_of(&MINI.replace("ior = [1.4, 1.6]", "iorr = [1.4, 1.6]"));
+        assert!(
+            e.contains("unknown range 'iorr'") && e.contains("roughness"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn odd_width_is_rejected() {
+        let e = err_of(&MINI.replace("width = 8", "width = 7"));
+        assert!(e.contains("[ci]") && e.contains("even"), "{e}");
+    }
+
+    #[test]
+    fn unknown_field_and_bad_version_are_rejected() {
+        assert!(err_of(&MINI.replace("seed = 7", "seed = 7\ncolour = 3")).contains("colour"));
+        assert!(err_of(&MINI.replace("version = 1", "version = 2")).contains("version = 2"));
+    }
+
+    #[test]
+    fn undefined_noise_level_and_bad_choice_are_rejected() {
+        let with_noise = MINI.replace("kind = \"shape\"", "kind = \"shape\"\nnoise = [\"loud\"]");
+        assert!(err_of(&with_noise).contains("'loud'"));
+        let with_choice = MINI.replace(
+            "kind = \"shape\"",
+            "kind = \"shape\"\nchoices = { shape = [\"cube\"] }",
+        );
+        assert!(err_of(&with_choice).contains("'cube'"));
+    }
+
+    #[test]
+    fn haze_is_accepted_but_pending() {
+        assert!(FamilyKind::Haze.pending_reason().unwrap().contains("media"));
+        assert!(FamilyKind::Shape.pending_reason().is_none());
+    }
+}
