@@ -1,0 +1,93 @@
+//! The division-of-focal-plane (DoFP) polarization sensor, both ways:
+//!
+//! - forward: [`SensorModel`] turns a Stokes image into the four polarizer
+//!   images and a noisy, quantised raw mosaic (the camera of the simulator);
+//! - inverse: [`demosaic()`] turns a raw mosaic into the four polarizer images
+//!   with a selectable [`DemosaicMethod`], and [`products`] fuses demosaicing
+//!   with Stokes, DoLP and AoLP for speed; [`mask`] flags pixels that cannot be
+//!   trusted and [`picture`] renders 8-bit pictures.
+//!
+//! The mosaic layout is the Sony IMX250MZR one (see [`layout`]): super-pixel
+//! row 0 = `[90°, 45°]`, row 1 = `[135°, 0°]`. The physics (Malus's law, Stokes
+//! from intensities, DoLP, AoLP, Mueller matrices) comes from `polar-optics`.
+
+pub mod demosaic;
+pub mod layout;
+pub mod mask;
+pub mod picture;
+pub mod products;
+pub mod sensor;
+
+pub use demosaic::{DemosaicMethod, demosaic};
+pub use layout::{Mosaic, MosaicSample};
+pub use products::{StokesPlanes, stokes_planes};
+pub use sensor::{SensorModel, SensorOutput};
+
+use thiserror::Error;
+
+/// Errors of the sensor model and of the demosaicing front end.
+#[derive(Debug, Error, PartialEq)]
+pub enum SensorError {
+    /// The mosaic has an odd width or height: it is not made of whole 2x2 super-pixels.
+    #[error("mosaic is {width}x{height}: width and height must be even (whole 2x2 super-pixels)")]
+    OddSize {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+    },
+    /// The mosaic is smaller than one 2x2 super-pixel.
+    #[error("mosaic is {width}x{height}: at least one 2x2 super-pixel is needed")]
+    TooSmall {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+    },
+    /// A demosaicing method name that is not known.
+    #[error("unknown demosaicing method `{0}` (known: {known})", known = DemosaicMethod::names().join(", "))]
+    UnknownMethod(String),
+    /// An output buffer has the wrong size.
+    #[error("output is {got_width}x{got_height}, expected {width}x{height}")]
+    OutputSize {
+        /// Expected width.
+        width: usize,
+        /// Expected height.
+        height: usize,
+        /// Width given.
+        got_width: usize,
+        /// Height given.
+        got_height: usize,
+    },
+    /// A sensor parameter is out of its valid range.
+    #[error("invalid sensor parameter `{name}` = {value}: {reason}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// Value given.
+        value: f64,
+        /// Valid range.
+        reason: &'static str,
+    },
+    /// An input Stokes value is negative or not finite.
+    #[error("Stokes image pixel ({x}, {y}) has a non-finite or negative S0 ({s0})")]
+    BadStokes {
+        /// Column.
+        x: usize,
+        /// Row.
+        y: usize,
+        /// The offending S0.
+        s0: f32,
+    },
+}
+
+/// Checks that a mosaic of `width x height` is made of whole 2x2 super-pixels.
+pub fn check_mosaic_size(width: usize, height: usize) -> Result<(), SensorError> {
+    if width < 2 || height < 2 {
+        return Err(SensorError::TooSmall { width, height });
+    }
+    if !width.is_multiple_of(2) || !height.is_multiple_of(2) {
+        return Err(SensorError::OddSize { width, height });
+    }
+    Ok(())
+}

@@ -1,0 +1,117 @@
+//! Validity mask: which output pixels cannot be trusted.
+//!
+//! A pixel is flagged [`SATURATED`] when any raw sample its demosaicing method
+//! reads (see [`DemosaicMethod::support_radius`]) is at the saturation level:
+//! the true intensity is unknown there, so Stokes, DoLP and AoLP are biased.
+//! It is flagged [`ZERO`] where `S0 <= 0` (or not finite): DoLP and AoLP are
+//! undefined there and are NaN in the float outputs.
+
+use polar_image::Gray;
+use rayon::prelude::*;
+
+use crate::demosaic::DemosaicMethod;
+use crate::layout::{Mosaic, MosaicSample};
+
+/// Flag bit: a raw sample used by this pixel is saturated.
+pub const SATURATED: u8 = 1;
+/// Flag bit: `S0` is zero (or negative / not finite), so DoLP and AoLP are undefined.
+pub const ZERO: u8 = 2;
+
+/// Flags per output pixel (`0` = valid) for `raw` demosaiced with `method` into planes
+/// whose `S0` is `s0`. `saturation` is the saturation level in DN (e.g. `2^bits − 1`).
+pub fn validity_mask<T: MosaicSample>(
+    raw: &Mosaic<T>,
+    saturation: u32,
+    method: DemosaicMethod,
+    s0: &Gray<f32>,
+) -> Gray<u8> {
+    let sat = saturated_support(raw, saturation, method);
+    let mut mask = Gray::<u8>::new(s0.width(), s0.height());
+    mask.as_mut_slice()
+        .par_iter_mut()
+        .zip(sat.as_slice())
+        .zip(s0.as_slice())
+        .for_each(|((m, &s), &v)| {
+            *m = if s { SATURATED } else { 0 } | if v > 0.0 && v.is_finite() { 0 } else { ZERO };
+        });
+    mask
+}
+
+/// `true` at output pixels whose demosaicing support holds a sample `>= saturation`.
+fn saturated_support<T: MosaicSample>(
+    raw: &Mosaic<T>,
+    saturation: u32,
+    method: DemosaicMethod,
+) -> Gray<bool> {
+    let (w, h) = raw.size();
+    let src = raw.as_slice();
+    let hit = |i: usize| src[i].into() >= saturation;
+    if method == DemosaicMethod::Superpixel {
+        let data = (0..(w / 2) * (h / 2))
+            .map(|k| {
+                let (x, y) = (2 * (k % (w / 2)), 2 * (k / (w / 2)));
+                [0, 1, w, w + 1].iter().any(|&d| hit(y * w + x + d))
+            })
+            .collect();
+        return Gray::from_vec(w / 2, h / 2, data).expect("size matches");
+    }
+    // Separable dilation of the saturated samples by a (2r+1) square, centred on
+    // the clamped pixel because border pixels copy their inner neighbour (bilinear).
+    let r = method.support_radius();
+    let centre = |v: usize, n: usize| if n >= 4 { v.clamp(1, n - 2) } else { v };
+    let rows: Vec<bool> = (0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = (centre(k % w, w), k / w);
+            (x.saturating_sub(r)..(x + r + 1).min(w)).any(|xx| hit(y * w + xx))
+        })
+        .collect();
+    let data = (0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = (k % w, centre(k / w, h));
+            (y.saturating_sub(r)..(y + r + 1).min(h)).any(|yy| rows[yy * w + x])
+        })
+        .collect();
+    Gray::from_vec(w, h, data).expect("size matches")
+}
+
+/// Number of raw samples at or above `saturation`.
+pub fn count_saturated<T: MosaicSample>(raw: &Mosaic<T>, saturation: u32) -> usize {
+    raw.as_slice()
+        .par_iter()
+        .filter(|&&v| v.into() >= saturation)
+        .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::products::stokes_planes;
+
+    #[test]
+    fn saturated_sample_flags_its_bilinear_neighbourhood_only() {
+        let mut raw = Mosaic::<u8>::from_vec(8, 8, vec![100; 64]).unwrap();
+        raw.as_mut_slice()[4 * 8 + 4] = 255;
+        let planes = stokes_planes(&raw, DemosaicMethod::Bilinear).unwrap();
+        let mask = validity_mask(&raw, 255, DemosaicMethod::Bilinear, &planes.s0);
+        for y in 0..8usize {
+            for x in 0..8usize {
+                let near = x.abs_diff(4) <= 1 && y.abs_diff(4) <= 1;
+                assert_eq!(
+                    mask.pixel(x, y)[0],
+                    if near { SATURATED } else { 0 },
+                    "({x},{y})"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn zero_intensity_is_flagged() {
+        let raw = Mosaic::<u16>::new(4, 4);
+        let planes = stokes_planes(&raw, DemosaicMethod::Superpixel).unwrap();
+        let mask = validity_mask(&raw, 4095, DemosaicMethod::Superpixel, &planes.s0);
+        assert!(mask.as_slice().iter().all(|&m| m == ZERO));
+    }
+}

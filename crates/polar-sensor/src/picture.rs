@@ -1,0 +1,149 @@
+//! 8-bit RGB pictures of polarization images.
+//!
+//! - [`aolp_hsv`]: hue = AoLP, saturation = 1, value = DoLP, exactly as
+//!   polanalyser's `applyColorToAoLP(aolp, value=dolp)` (OpenCV hue `0..179`,
+//!   `COLOR_HSV2BGR`), but returned as RGB.
+//! - [`colormap`]: a scalar image through a viridis-like colour map.
+//!
+//! Undefined pixels (NaN) are black.
+
+use polar_image::{Gray, Image};
+use rayon::prelude::*;
+
+/// An 8-bit RGB picture.
+pub type Rgb8 = Image<u8, 3>;
+
+/// AoLP (radians) as hue and DoLP as value; NaN in either gives black.
+///
+/// Quantisation follows polanalyser: `hue = trunc(mod(aolp, π) / π · 179)`,
+/// `value = trunc(clip(dolp, 0, 1) · 255)`, then OpenCV's 8-bit HSV -> RGB.
+pub fn aolp_hsv(aolp: &Gray<f32>, dolp: &Gray<f32>) -> Rgb8 {
+    let mut out = Rgb8::new(aolp.width(), aolp.height());
+    out.pixels_mut()
+        .par_iter_mut()
+        .zip(aolp.as_slice())
+        .zip(dolp.as_slice())
+        .for_each(|((px, &a), &d)| {
+            if a.is_finite() && d.is_finite() {
+                let hue = (a.rem_euclid(std::f32::consts::PI) / std::f32::consts::PI * 179.0) as u8;
+                let value = (d.clamp(0.0, 1.0) * 255.0) as u8;
+                *px = hsv_to_rgb(hue, 255, value);
+            }
+        });
+    out
+}
+
+/// OpenCV's 8-bit `HSV2RGB`: hue in `0..180` (2° steps), saturation and value in `0..=255`.
+pub fn hsv_to_rgb(h: u8, s: u8, v: u8) -> [u8; 3] {
+    let (s, v) = (f32::from(s) / 255.0, f32::from(v) / 255.0);
+    let h = (f32::from(h) * (6.0 / 180.0)).rem_euclid(6.0);
+    let sector = h.floor();
+    let f = h - sector;
+    let tab = [
+        v,
+        v * (1.0 - s),
+        v * (1.0 - s * f),
+        v * (1.0 - s * (1.0 - f)),
+    ];
+    // (r, g, b) indices into `tab` per 60° sector.
+    const SECTORS: [[usize; 3]; 6] = [
+        [0, 3, 1],
+        [2, 0, 1],
+        [1, 0, 3],
+        [1, 2, 0],
+        [3, 1, 0],
+        [0, 1, 2],
+    ];
+    SECTORS[sector as usize % 6].map(|i| (tab[i] * 255.0).round().clamp(0.0, 255.0) as u8)
+}
+
+/// Anchor colours of the map at `t = 0, 1/8, …, 1` (sampled from matplotlib's viridis), linearly interpolated.
+const VIRIDIS: [[f32; 3]; 9] = [
+    [68.0, 1.0, 84.0],
+    [71.0, 44.0, 122.0],
+    [59.0, 81.0, 139.0],
+    [44.0, 113.0, 142.0],
+    [33.0, 144.0, 141.0],
+    [39.0, 173.0, 129.0],
+    [92.0, 200.0, 99.0],
+    [170.0, 220.0, 50.0],
+    [253.0, 231.0, 37.0],
+];
+
+/// Colour of `t` in `[0, 1]` (clamped) on the viridis-like map.
+pub fn viridis(t: f32) -> [u8; 3] {
+    let u = t.clamp(0.0, 1.0) * (VIRIDIS.len() - 1) as f32;
+    let i = (u.floor() as usize).min(VIRIDIS.len() - 2);
+    let f = u - i as f32;
+    std::array::from_fn(|c| (VIRIDIS[i][c] + f * (VIRIDIS[i + 1][c] - VIRIDIS[i][c])).round() as u8)
+}
+
+/// `values` mapped linearly from `[vmin, vmax]` onto the colour map; NaN gives black.
+pub fn colormap(values: &Gray<f32>, vmin: f32, vmax: f32) -> Rgb8 {
+    let scale = if vmax > vmin {
+        1.0 / (vmax - vmin)
+    } else {
+        0.0
+    };
+    let mut out = Rgb8::new(values.width(), values.height());
+    out.pixels_mut()
+        .par_iter_mut()
+        .zip(values.as_slice())
+        .for_each(|(px, &v)| {
+            if v.is_finite() {
+                *px = viridis((v - vmin) * scale);
+            }
+        });
+    out
+}
+
+/// The `q`-quantile (`0..=1`) of the finite values, or `None` if there are none:
+/// a robust upper end for [`colormap`] that a few hot pixels cannot dominate.
+pub fn quantile(values: &Gray<f32>, q: f64) -> Option<f32> {
+    let mut v: Vec<f32> = values
+        .as_slice()
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    if v.is_empty() {
+        return None;
+    }
+    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+    Some(*v.select_nth_unstable_by(k, f32::total_cmp).1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hsv_primaries() {
+        assert_eq!(hsv_to_rgb(0, 255, 255), [255, 0, 0]);
+        assert_eq!(hsv_to_rgb(60, 255, 255), [0, 255, 0]);
+        assert_eq!(hsv_to_rgb(120, 255, 255), [0, 0, 255]);
+        assert_eq!(hsv_to_rgb(30, 255, 255), [255, 255, 0]);
+        assert_eq!(hsv_to_rgb(77, 0, 200), [200, 200, 200]);
+    }
+
+    #[test]
+    fn undefined_pixels_are_black() {
+        let a = Gray::from_vec(2, 1, vec![f32::NAN, 0.0]).unwrap();
+        let d = Gray::from_vec(2, 1, vec![0.5, f32::NAN]).unwrap();
+        assert_eq!(aolp_hsv(&a, &d).as_slice(), &[0; 6]);
+        assert_eq!(colormap(&a, 0.0, 1.0).pixels()[0], [0, 0, 0]);
+    }
+
+    #[test]
+    fn viridis_ends_and_quantile() {
+        assert_eq!(viridis(-1.0), [68, 1, 84]);
+        assert_eq!(viridis(2.0), [253, 231, 37]);
+        let g = Gray::from_vec(5, 1, vec![3.0, f32::NAN, 1.0, 2.0, 100.0]).unwrap();
+        assert_eq!(quantile(&g, 0.0), Some(1.0));
+        assert_eq!(quantile(&g, 0.5), Some(3.0));
+        assert_eq!(
+            quantile(&Gray::from_vec(1, 1, vec![f32::NAN]).unwrap(), 0.5),
+            None
+        );
+    }
+}

@@ -1,0 +1,3 @@
+//! `polar-vision`: command-line front end of the polarization vision pipeline.
+
+fn main() {}

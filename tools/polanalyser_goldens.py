@@ -1,0 +1,172 @@
+#!/usr/bin/env python3
+"""Golden data from polanalyser/OpenCV for the polar-sensor front end, and a full-frame check.
+
+Default mode writes small JSON fixtures to crates/polar-sensor/tests/data/:
+  bilinear_u8.json, bilinear_u16.json   random mosaics (every DN pattern, borders included)
+  real_crop_u8.json                     a 48x32 crop of a bundled real IMX250MZR frame
+Each holds the raw mosaic and polanalyser's outputs: the four demosaiced images
+(COLOR_PolarMono), calcLinearStokes S0..S2, cvtStokesToDoLP, cvtStokesToAoLP and
+applyColorToAoLP(aolp, value=dolp) converted to RGB. Undefined values (NaN) are null.
+
+--check runs the real `polar-vision stokes` binary (cargo build --release) on each
+bundled real frame and compares its stokes.exr / dolp.exr / aolp.exr / aolp.png
+with polanalyser on the full frame; exits non-zero if a tolerance is exceeded.
+
+Run with the pinned venv: tools/.venv/bin/python tools/polanalyser_goldens.py [--check]
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from importlib.metadata import version
+from pathlib import Path
+
+import cv2
+import numpy as np
+import polanalyser as pa
+
+ROOT = Path(__file__).resolve().parent.parent
+FIXTURES = ROOT / "crates" / "polar-sensor" / "tests" / "data"
+REAL = ROOT / "tests" / "data" / "real"
+ANGLES = np.deg2rad([0, 45, 90, 135])
+
+# Tolerances of --check (full frame, bilinear).
+STOKES_REL_TOL = 1e-4  # max |ours - polanalyser| / max |polanalyser| per S0, S1, S2
+DOLP_ABS_TOL = 1e-5  # f32 vs f64 rounding of sqrt(S1^2+S2^2)/S0
+AOLP_ABS_TOL = 1e-5  # radians, circular difference modulo pi
+PICTURE_DN_TOL = 1  # aolp.png vs applyColorToAoLP, per channel
+
+
+def polanalyser_chain(raw):
+    """polanalyser's chain: demosaicing, calcLinearStokes, DoLP, AoLP (float64)."""
+    imgs = pa.demosaicing(raw, pa.COLOR_PolarMono)
+    stokes = pa.calcLinearStokes(np.stack(imgs), ANGLES)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dolp = pa.cvtStokesToDoLP(stokes)
+    aolp = pa.cvtStokesToAoLP(stokes)
+    return imgs, stokes, dolp, aolp
+
+
+def aolp_picture_rgb(aolp, dolp):
+    """applyColorToAoLP(aolp, value=dolp) as RGB, black where DoLP/AoLP are undefined."""
+    ok = np.isfinite(aolp) & np.isfinite(dolp)
+    bgr = pa.applyColorToAoLP(np.where(ok, aolp, 0), value=np.where(ok, np.clip(dolp, 0, 1), 0))
+    rgb = bgr[..., ::-1].copy()
+    rgb[~ok] = 0
+    return rgb
+
+
+def as_list(a):
+    return [None if not np.isfinite(v) else float(v) for v in np.asarray(a, dtype=np.float64).ravel()]
+
+
+def fixture(raw, bits):
+    imgs, stokes, dolp, aolp = polanalyser_chain(raw)
+    h, w = raw.shape
+    return {
+        "source": f"polanalyser {version('polanalyser')}, OpenCV {cv2.__version__}",
+        "width": w,
+        "height": h,
+        "bits": bits,
+        "raw": raw.ravel().tolist(),
+        "i0": imgs[0].ravel().tolist(),
+        "i45": imgs[1].ravel().tolist(),
+        "i90": imgs[2].ravel().tolist(),
+        "i135": imgs[3].ravel().tolist(),
+        "s0": as_list(stokes[..., 0]),
+        "s1": as_list(stokes[..., 1]),
+        "s2": as_list(stokes[..., 2]),
+        "dolp": as_list(dolp),
+        "aolp": as_list(aolp),
+        "aolp_rgb": aolp_picture_rgb(aolp, dolp).ravel().tolist(),
+    }
+
+
+def write_fixtures():
+    FIXTURES.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(20261123)
+    raw8 = rng.integers(0, 256, (10, 12), dtype=np.uint8)
+    raw8[4:6, 4:6] = 0  # a zero super-pixel: S0 = 0 in its centre, DoLP/AoLP undefined
+    raw16 = rng.integers(0, 65536, (12, 16), dtype=np.uint16)
+    real = cv2.imread(str(REAL / "carps_IMX250MZR.png"), cv2.IMREAD_UNCHANGED)
+    crop = np.ascontiguousarray(real[800:832, 1000:1048])
+    for name, raw, bits in [("bilinear_u8", raw8, 8), ("bilinear_u16", raw16, 16), ("real_crop_u8", crop, 8)]:
+        path = FIXTURES / f"{name}.json"
+        path.write_text(json.dumps(fixture(raw, bits)))
+        print(f"wrote {path.relative_to(ROOT)} ({path.stat().st_size // 1024} KiB)")
+
+
+def read_exr(path):
+    """Named float channels of an EXR file, via Mitsuba's Bitmap (in the pinned venv)."""
+    import mitsuba as mi
+
+    mi.set_variant("scalar_rgb")
+    bmp = mi.Bitmap(str(path))
+    return {name: np.array(b, copy=False)[..., 0] if np.array(b).ndim == 3 else np.array(b) for name, b in bmp.split()}
+
+
+def build_binary():
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    subprocess.run(["cargo", "build", "--release", "--locked", "-p", "polar-vision"], cwd=ROOT, check=True)
+    return target / "release" / "polar-vision"
+
+
+def circular_diff(a, b):
+    d = np.abs(a - b) % np.pi
+    return np.minimum(d, np.pi - d)
+
+
+def check():
+    exe = build_binary()
+    failures = []
+    for frame in sorted(REAL.glob("*.png")):
+        raw = cv2.imread(str(frame), cv2.IMREAD_UNCHANGED)
+        _, stokes, dolp, aolp = polanalyser_chain(raw)
+        with tempfile.TemporaryDirectory() as out:
+            subprocess.run([str(exe), "stokes", str(frame), "--out", out, "--demosaic", "bilinear"], check=True)
+            ours = read_exr(Path(out) / "stokes.exr")
+            our_dolp = read_exr(Path(out) / "dolp.exr")["Y"]
+            our_aolp = read_exr(Path(out) / "aolp.exr")["Y"]
+            picture = cv2.imread(str(Path(out) / "aolp.png"), cv2.IMREAD_UNCHANGED)[..., ::-1]
+        print(f"{frame.name}:")
+        for i, name in enumerate(["S0", "S1", "S2"]):
+            ref = stokes[..., i]
+            rel = np.max(np.abs(ours[name] - ref)) / np.max(np.abs(ref))
+            print(f"  {name}: max |diff| / max |ref| = {rel:.2e} (tol {STOKES_REL_TOL:.0e})")
+            if not rel <= STOKES_REL_TOL:
+                failures.append(f"{frame.name} {name} {rel:.2e}")
+        defined = np.isfinite(dolp)
+        if not np.array_equal(defined, np.isfinite(our_dolp)):
+            failures.append(f"{frame.name}: DoLP NaN pattern differs")
+        dd = np.max(np.abs(our_dolp[defined] - dolp[defined]), initial=0)
+        da = np.max(circular_diff(our_aolp[defined], aolp[defined]), initial=0)
+        dp = np.max(np.abs(picture.astype(int) - aolp_picture_rgb(aolp, dolp).astype(int)))
+        print(f"  DoLP max |diff| = {dd:.2e} (tol {DOLP_ABS_TOL:.0e}); AoLP max |diff| = {da:.2e} rad (tol {AOLP_ABS_TOL:.0e})")
+        print(f"  aolp.png max |diff| = {dp} DN (tol {PICTURE_DN_TOL})")
+        if not dd <= DOLP_ABS_TOL:
+            failures.append(f"{frame.name} DoLP {dd:.2e}")
+        if not da <= AOLP_ABS_TOL:
+            failures.append(f"{frame.name} AoLP {da:.2e}")
+        if not dp <= PICTURE_DN_TOL:
+            failures.append(f"{frame.name} aolp.png {dp}")
+    if failures:
+        print("FAILED:", "; ".join(failures))
+        return 1
+    print("all real frames match polanalyser")
+    return 0
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--check", action="store_true", help="compare `polar-vision stokes` with polanalyser on the real frames")
+    args = parser.parse_args()
+    if args.check:
+        sys.exit(check())
+    write_fixtures()
+
+
+if __name__ == "__main__":
+    main()
