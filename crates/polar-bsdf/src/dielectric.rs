@@ -104,17 +104,24 @@ impl Dielectric {
 
     fn rough_sample(&self, ggx: &Ggx, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
         let h = ggx.sample_visible(wo, [u[1], u[2]]);
-        let wi = if u[0] < self.reflect_prob(wo, &h) {
+        let reflected = u[0] < self.reflect_prob(wo, &h);
+        let wi = if reflected {
             reflect(wo, &h)
         } else {
             let facing = h * wo.dot(&h).signum();
             refract(wo, &facing, self.etap(wo))?
         };
+        // A mirror direction below the surface (or a refraction that stays on
+        // the same side) is shadowed: no light, and it must not be mistaken for
+        // the other lobe when the pdf is recomputed from (wo, wi).
+        let is_transmission = wo.z * wi.z < 0.0;
+        if is_transmission == reflected {
+            return None;
+        }
         let pdf = self.rough_pdf(ggx, wo, &wi);
         if pdf <= 0.0 {
             return None;
         }
-        let is_transmission = wo.z * wi.z < 0.0;
         let eta = if is_transmission { self.etap(wo) } else { 1.0 };
         let weight = self.rough_eval(ggx, wo, &wi) / pdf;
         Some(BsdfSample {
