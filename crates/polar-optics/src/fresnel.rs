@@ -40,8 +40,9 @@ pub struct FresnelAmplitudes {
 ///
 /// Edge cases (all without NaN): `cos_i` is clamped to `[0, 1]` (grazing `cos_i = 0`
 /// gives `r_s = r_p = −1`); index matching `η = 1` returns `r = 0`, `t = 1` exactly;
-/// `|η| > 1e150` or infinite is the perfect-conductor limit `r_s = −1`, `r_p = +1`
-/// (`−1` at grazing), `t = 0`, so that `η²` never overflows. Undefined inputs give
+/// `|η| > 1e30` or infinite is the perfect-conductor limit `r_s = −1`, `r_p = +1`
+/// (`−1` at exactly grazing), `t = 0` (relative error `~1/|η|`, below `f64` precision),
+/// so that `|η²|²` never overflows in the complex divisions. Undefined inputs give
 /// NaN amplitudes: a NaN or infinite `cos_i`, or a NaN component of `eta`.
 pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
     let zero = Complex64::new(0.0, 0.0);
@@ -103,9 +104,10 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
     }
 }
 
-/// Above this `|η|` the interface is treated as a perfect conductor (relative
-/// error `~1/|η|`, and `η²` would overflow near `1e154`).
-const PERFECT_CONDUCTOR: f64 = 1e150;
+/// Above this `|η|` the interface is treated as a perfect conductor: the error is
+/// `~1/|η|`, and the complex division by `η² cos θi + w` squares `|η|²`, which
+/// overflows near `|η| = 1e77`.
+const PERFECT_CONDUCTOR: f64 = 1e30;
 
 impl FresnelAmplitudes {
     /// Power reflectances `(R_s, R_p)`.
