@@ -1,0 +1,41 @@
+//! Atomic writes: write beside the target under a temporary name, then rename.
+//! A reader never sees a half-written file, and a failed write leaves the old file intact.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::error::{Error, Result};
+
+/// A fresh hidden name in the same directory as `path`, so the final rename stays on one
+/// file system (rename is only atomic there).
+pub(crate) fn temp_sibling(path: &Path) -> PathBuf {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map_or_else(|| "out".into(), |s| s.to_string_lossy());
+    path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()))
+}
+
+/// Writes a file through `write_body`, atomically: the data goes to a temporary sibling that
+/// is renamed onto `path` only after it was written and flushed without error.
+pub(crate) fn write_file_atomic(
+    path: &Path,
+    write_body: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
+) -> Result<()> {
+    let tmp = temp_sibling(path);
+    let result = (|| {
+        let file = File::create(&tmp).map_err(|e| Error::io(path, "output", e))?;
+        let mut writer = BufWriter::new(file);
+        write_body(&mut writer)?;
+        writer.flush().map_err(|e| Error::io(path, "output", e))?;
+        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, "output", e))
+    })();
+    if result.is_err() {
+        // Best effort: the temporary may not exist if creating it was what failed.
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}

@@ -1,0 +1,175 @@
+//! Float OpenEXR images with named channels (S0..S3; R, G, B; Y), through the `exr` crate.
+//! Files are written single-layer, float32, ZIP-compressed scanlines; any single-layer file
+//! (scanline or tiled, f16/f32/u32 samples) is readable.
+
+use std::path::Path;
+
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, MetaData, ReadChannels,
+    ReadLayers, Text, WritableImage, read,
+};
+use polar_image::{Gray, Image};
+
+use crate::atomic::write_file_atomic;
+use crate::error::{Error, Result};
+
+/// Writes `image` as a single-layer float32 EXR whose channel `c` is named `names[c]`,
+/// atomically. Names must be non-empty, distinct and Latin-1 (an EXR rule).
+pub fn write_exr<const C: usize>(
+    path: impl AsRef<Path>,
+    image: &Image<f32, C>,
+    names: [&str; C],
+) -> Result<()> {
+    let path = path.as_ref();
+    let texts = channel_texts(path, &names)?;
+    let (width, height) = image.size();
+    if width == 0 || height == 0 {
+        return Err(Error::Dimensions {
+            path: path.to_owned(),
+            width,
+            height,
+        });
+    }
+    let channels: Vec<AnyChannel<FlatSamples>> = texts
+        .into_iter()
+        .enumerate()
+        .map(|(c, name)| {
+            let plane = image.pixels().iter().map(|p| p[c]).collect();
+            AnyChannel::new(name, FlatSamples::F32(plane))
+        })
+        .collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels.into()),
+    );
+    let exr_image = exr::prelude::Image::from_layer(layer);
+    write_file_atomic(path, |writer| {
+        exr_image
+            .write()
+            .to_buffered(writer)
+            .map_err(|e| exr_error(path, e))
+    })
+}
+
+/// Reads the channels `names` (in that order) of a single-layer EXR into a `C`-channel image.
+/// A channel the file lacks gives [`Error::MissingChannel`], naming the channels present.
+pub fn read_exr<const C: usize>(path: impl AsRef<Path>, names: [&str; C]) -> Result<Image<f32, C>> {
+    let path = path.as_ref();
+    let layer = read_single_layer(path)?;
+    let (width, height) = (layer.size.0, layer.size.1);
+    let planes = names.map(|name| find_channel(path, &layer, name));
+    let mut data = vec![0.0f32; width * height * C];
+    for (c, plane) in planes.into_iter().enumerate() {
+        let samples = &plane?.sample_data;
+        if samples.len() != width * height {
+            return Err(Error::corrupt(
+                path,
+                "EXR",
+                "subsampled channels are not supported",
+            ));
+        }
+        for (dst, v) in data
+            .iter_mut()
+            .skip(c)
+            .step_by(C)
+            .zip(samples.values_as_f32())
+        {
+            *dst = v;
+        }
+    }
+    Image::from_vec(width, height, data).map_err(|e| Error::corrupt(path, "EXR", e))
+}
+
+/// Reads the one channel `name` of a single-layer EXR.
+pub fn read_exr_channel(path: impl AsRef<Path>, name: &str) -> Result<Gray<f32>> {
+    read_exr(path, [name])
+}
+
+/// The channel names of an EXR file's first layer, from its header only (no pixels decoded).
+pub fn exr_channel_names(path: impl AsRef<Path>) -> Result<Vec<String>> {
+    let path = path.as_ref();
+    let meta = MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
+    let header = meta.headers.first().ok_or_else(|| Error::LayerCount {
+        path: path.to_owned(),
+        layers: 0,
+    })?;
+    Ok(header
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect())
+}
+
+type AnyLayer = Layer<AnyChannels<FlatSamples>>;
+
+fn read_single_layer(path: &Path) -> Result<AnyLayer> {
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| exr_error(path, e))?;
+    let layers = image.layer_data.len();
+    match <[AnyLayer; 1]>::try_from(image.layer_data.into_vec()) {
+        Ok([layer]) => Ok(layer),
+        Err(_) => Err(Error::LayerCount {
+            path: path.to_owned(),
+            layers,
+        }),
+    }
+}
+
+fn find_channel<'a>(
+    path: &Path,
+    layer: &'a AnyLayer,
+    name: &str,
+) -> Result<&'a AnyChannel<FlatSamples>> {
+    let list = &layer.channel_data.list;
+    list.iter()
+        .find(|c| c.name == *name)
+        .ok_or_else(|| Error::MissingChannel {
+            path: path.to_owned(),
+            channel: name.to_owned(),
+            present: list.iter().map(|c| c.name.to_string()).collect(),
+        })
+}
+
+/// Validates channel names for writing and converts them to EXR text.
+fn channel_texts(path: &Path, names: &[&str]) -> Result<Vec<Text>> {
+    let bad = |reason| Error::ChannelNames {
+        path: path.to_owned(),
+        names: names.iter().map(|s| s.to_string()).collect(),
+        reason,
+    };
+    if names.is_empty() {
+        return Err(bad("at least one channel is needed"));
+    }
+    if names.iter().any(|n| n.is_empty()) {
+        return Err(bad("a name is empty"));
+    }
+    if names
+        .iter()
+        .enumerate()
+        .any(|(i, n)| names[..i].contains(n))
+    {
+        return Err(bad("a name is repeated"));
+    }
+    names
+        .iter()
+        .map(|n| Text::new_or_none(n).ok_or_else(|| bad("a name is not Latin-1")))
+        .collect()
+}
+
+/// Maps an `exr` error: I/O keeps its kind (not found, ...); anything the decoder rejects
+/// (including an unexpected end of file, which `exr` reports as invalid) is a corrupt file.
+fn exr_error(path: &Path, err: exr::error::Error) -> Error {
+    match err {
+        exr::error::Error::Io(e) => Error::io(path, "EXR", e),
+        other => Error::corrupt(path, "EXR", other),
+    }
+}

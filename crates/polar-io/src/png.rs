@@ -1,0 +1,303 @@
+//! Grayscale (8/16-bit) and RGB (8-bit) PNG through the `png` crate (the `image` crate's codec,
+//! used directly because `image` silently rescales 1/2/4-bit files to 8 bits).
+//! Mosaics, label maps and masks are grayscale; RGB is for visualisations only.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use polar_image::{Gray, Image};
+
+use crate::atomic::write_file_atomic;
+use crate::error::{Error, Result};
+
+/// Largest decoded image accepted (bytes). Guards against headers that claim absurd sizes.
+const MAX_DECODED_BYTES: usize = 1 << 30;
+
+/// Bits per sample of a grayscale PNG. Only 8 and 16 are used by the project.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BitDepth {
+    /// 8 bits per sample, values 0..=255.
+    Eight,
+    /// 16 bits per sample, values 0..=65535.
+    Sixteen,
+}
+
+impl BitDepth {
+    /// Bits per sample: 8 or 16.
+    pub fn bits(self) -> u8 {
+        match self {
+            BitDepth::Eight => 8,
+            BitDepth::Sixteen => 16,
+        }
+    }
+
+    /// Largest representable value: 255 or 65535.
+    pub fn max_value(self) -> u16 {
+        match self {
+            BitDepth::Eight => u16::from(u8::MAX),
+            BitDepth::Sixteen => u16::MAX,
+        }
+    }
+}
+
+/// A grayscale PNG as read: samples widened to `u16` (values unchanged, not rescaled),
+/// plus the bit depth the file stored them at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GrayPng {
+    /// The samples, row 0 at the top.
+    pub image: Gray<u16>,
+    /// The depth in the file; every sample is `<= bit_depth.max_value()`.
+    pub bit_depth: BitDepth,
+}
+
+/// Reads an 8- or 16-bit grayscale PNG. Colour PNGs give [`Error::ColorType`],
+/// 1/2/4-bit ones [`Error::BitDepth`] (their values would need rescaling to mean DN).
+pub fn read_gray_png(path: impl AsRef<Path>) -> Result<GrayPng> {
+    let path = path.as_ref();
+    let d = decode(path)?;
+    if d.color != png::ColorType::Grayscale {
+        return Err(color_error(path, &d, "grayscale"));
+    }
+    let (bit_depth, data) = match d.depth {
+        png::BitDepth::Eight => (
+            BitDepth::Eight,
+            d.bytes.into_iter().map(u16::from).collect(),
+        ),
+        png::BitDepth::Sixteen => (BitDepth::Sixteen, u16_from_be_bytes(&d.bytes)),
+        other => {
+            return Err(Error::BitDepth {
+                path: path.to_owned(),
+                found: other as u8,
+                expected: "8 or 16",
+            });
+        }
+    };
+    Ok(GrayPng {
+        image: gray_from_vec(path, d.size, data)?,
+        bit_depth,
+    })
+}
+
+/// Reads an 8-bit grayscale PNG (label maps, masks); another depth gives [`Error::BitDepth`].
+pub fn read_gray8_png(path: impl AsRef<Path>) -> Result<Gray<u8>> {
+    let path = path.as_ref();
+    let d = decode(path)?;
+    if d.color != png::ColorType::Grayscale {
+        return Err(color_error(path, &d, "grayscale"));
+    }
+    if d.depth != png::BitDepth::Eight {
+        return Err(Error::BitDepth {
+            path: path.to_owned(),
+            found: d.depth as u8,
+            expected: "8",
+        });
+    }
+    gray_from_vec(path, d.size, d.bytes)
+}
+
+/// Reads a division-of-focal-plane mosaic: an 8- or 16-bit grayscale PNG whose width and
+/// height are even and at least 2 (whole 2x2 super-pixels, layout in the conventions).
+pub fn read_mosaic(path: impl AsRef<Path>) -> Result<GrayPng> {
+    let path = path.as_ref();
+    let png = read_gray_png(path)?;
+    check_mosaic_size(path, png.image.width(), png.image.height())?;
+    Ok(png)
+}
+
+/// Checks that a `width x height` mosaic holds whole 2x2 super-pixels.
+pub fn check_mosaic_size(path: &Path, width: usize, height: usize) -> Result<()> {
+    let ok = |n: usize| n >= 2 && n.is_multiple_of(2);
+    if ok(width) && ok(height) {
+        Ok(())
+    } else {
+        Err(Error::MosaicSize {
+            path: path.to_owned(),
+            width,
+            height,
+        })
+    }
+}
+
+/// Reads an 8-bit RGB PNG (no alpha, no palette).
+pub fn read_rgb8_png(path: impl AsRef<Path>) -> Result<Image<u8, 3>> {
+    let path = path.as_ref();
+    let d = decode(path)?;
+    if (d.color, d.depth) != (png::ColorType::Rgb, png::BitDepth::Eight) {
+        return Err(color_error(path, &d, "Rgb, 8-bit"));
+    }
+    Image::from_vec(d.size.0, d.size.1, d.bytes).map_err(|e| Error::corrupt(path, "PNG", e))
+}
+
+/// Writes an 8-bit grayscale PNG, atomically.
+pub fn write_gray8_png(path: impl AsRef<Path>, image: &Gray<u8>) -> Result<()> {
+    encode(
+        path.as_ref(),
+        image.size(),
+        image.as_slice(),
+        png::ColorType::Grayscale,
+        png::BitDepth::Eight,
+    )
+}
+
+/// Writes a 16-bit grayscale PNG, atomically.
+pub fn write_gray16_png(path: impl AsRef<Path>, image: &Gray<u16>) -> Result<()> {
+    let bytes: Vec<u8> = image
+        .as_slice()
+        .iter()
+        .flat_map(|v| v.to_be_bytes())
+        .collect();
+    encode(
+        path.as_ref(),
+        image.size(),
+        &bytes,
+        png::ColorType::Grayscale,
+        png::BitDepth::Sixteen,
+    )
+}
+
+/// Writes `png.image` at `png.bit_depth`; at 8 bits a sample above 255 gives
+/// [`Error::ValueRange`] (never silently clipped).
+pub fn write_gray_png(path: impl AsRef<Path>, png: &GrayPng) -> Result<()> {
+    let path = path.as_ref();
+    match png.bit_depth {
+        BitDepth::Sixteen => write_gray16_png(path, &png.image),
+        BitDepth::Eight => write_gray8_png(path, &narrow_to_u8(path, &png.image)?),
+    }
+}
+
+/// Writes an 8-bit RGB PNG (visualisations such as the AoLP/DoLP picture), atomically.
+pub fn write_rgb8_png(path: impl AsRef<Path>, image: &Image<u8, 3>) -> Result<()> {
+    encode(
+        path.as_ref(),
+        image.size(),
+        image.as_slice(),
+        png::ColorType::Rgb,
+        png::BitDepth::Eight,
+    )
+}
+
+/// `u16` samples as `u8`, failing on the first that does not fit.
+fn narrow_to_u8(path: &Path, image: &Gray<u16>) -> Result<Gray<u8>> {
+    let width = image.width().max(1);
+    let data = image
+        .as_slice()
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            u8::try_from(v).map_err(|_| Error::ValueRange {
+                path: path.to_owned(),
+                x: i % width,
+                y: i / width,
+                value: u32::from(v),
+                bits: 8,
+            })
+        })
+        .collect::<Result<Vec<u8>>>()?;
+    gray_from_vec(path, image.size(), data)
+}
+
+fn gray_from_vec<T>(path: &Path, (width, height): (usize, usize), data: Vec<T>) -> Result<Gray<T>> {
+    Gray::from_vec(width, height, data).map_err(|e| Error::corrupt(path, "PNG", e))
+}
+
+fn u16_from_be_bytes(bytes: &[u8]) -> Vec<u16> {
+    bytes
+        .as_chunks::<2>()
+        .0
+        .iter()
+        .map(|&b| u16::from_be_bytes(b))
+        .collect()
+}
+
+/// Decodes a PNG without transformations (values as stored, big-endian for 16 bits), with
+/// its colour type, bit depth and `(width, height)`.
+fn decode(path: &Path) -> Result<Decoded> {
+    let file = File::open(path).map_err(|e| Error::io(path, "PNG", e))?;
+    let limits = png::Limits {
+        bytes: MAX_DECODED_BYTES,
+    };
+    let mut decoder = png::Decoder::new_with_limits(BufReader::new(file), limits);
+    decoder.set_transformations(png::Transformations::IDENTITY);
+    let mut reader = decoder.read_info().map_err(|e| decode_error(path, e))?;
+    let len = reader
+        .output_buffer_size()
+        .ok_or_else(|| Error::corrupt(path, "PNG", "image size overflows memory"))?;
+    let mut bytes = vec![0; len];
+    let frame = reader
+        .next_frame(&mut bytes)
+        .map_err(|e| decode_error(path, e))?;
+    bytes.truncate(frame.buffer_size());
+    Ok(Decoded {
+        color: frame.color_type,
+        depth: frame.bit_depth,
+        size: (frame.width as usize, frame.height as usize),
+        bytes,
+    })
+}
+
+/// A decoded PNG, samples as stored.
+struct Decoded {
+    color: png::ColorType,
+    depth: png::BitDepth,
+    size: (usize, usize),
+    bytes: Vec<u8>,
+}
+
+/// Maps a `png` decoding error: I/O keeps its kind, the rest is a corrupt file.
+fn decode_error(path: &Path, err: png::DecodingError) -> Error {
+    match err {
+        png::DecodingError::IoError(e) => Error::io(path, "PNG", e),
+        other => Error::corrupt(path, "PNG", other),
+    }
+}
+
+/// "Rgb, 8-bit" and the like, for error messages.
+fn describe(color: png::ColorType, depth: png::BitDepth) -> String {
+    format!("{color:?}, {}-bit", depth as u8)
+}
+
+fn color_error(path: &Path, d: &Decoded, expected: &'static str) -> Error {
+    Error::ColorType {
+        path: path.to_owned(),
+        found: describe(d.color, d.depth),
+        expected,
+    }
+}
+
+/// Encodes `bytes` (big-endian for 16 bits, as PNG stores them) at `path`, atomically.
+/// Fast deflate: mosaics are noisy, so stronger compression costs much time for few bytes.
+fn encode(
+    path: &Path,
+    (width, height): (usize, usize),
+    bytes: &[u8],
+    color: png::ColorType,
+    depth: png::BitDepth,
+) -> Result<()> {
+    let dims_error = || Error::Dimensions {
+        path: path.to_owned(),
+        width,
+        height,
+    };
+    let w = u32::try_from(width).map_err(|_| dims_error())?;
+    let h = u32::try_from(height).map_err(|_| dims_error())?;
+    if w == 0 || h == 0 {
+        return Err(dims_error());
+    }
+    let encode_error = |e: png::EncodingError| match e {
+        png::EncodingError::IoError(io) => Error::io(path, "PNG", io),
+        other => Error::Io {
+            path: path.to_owned(),
+            source: std::io::Error::other(other),
+        },
+    };
+    write_file_atomic(path, |writer| {
+        let mut encoder = png::Encoder::new(writer, w, h);
+        encoder.set_color(color);
+        encoder.set_depth(depth);
+        encoder.set_compression(png::Compression::Fast);
+        let mut png_writer = encoder.write_header().map_err(encode_error)?;
+        png_writer.write_image_data(bytes).map_err(encode_error)?;
+        png_writer.finish().map_err(encode_error)
+    })
+}
