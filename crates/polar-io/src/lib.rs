@@ -10,6 +10,7 @@ mod atomic;
 mod error;
 mod openexr;
 mod png;
+mod sample;
 mod validate;
 
 pub use error::{Error, Result};
@@ -17,6 +18,10 @@ pub use openexr::{exr_channel_names, read_exr, read_exr_channel, write_exr};
 pub use png::{
     BitDepth, GrayPng, check_mosaic_size, read_gray_png, read_gray8_png, read_mosaic,
     read_rgb8_png, write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png,
+};
+pub use sample::{
+    GroundTruth, Sample, TRANSPARENT_MASK_ON, files, material, read_json, read_sample,
+    read_sample_with, write_json, write_sample,
 };
 pub use validate::{Rule, Validation, check_channels, check_stokes, check_u8};
 

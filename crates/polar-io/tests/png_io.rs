@@ -235,6 +235,25 @@ fn gray_with_alpha_is_a_colour_type_error() {
 }
 
 #[test]
+fn palette_png_is_a_colour_type_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("pal.png");
+    let file = std::fs::File::create(&path).unwrap();
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), 2, 2);
+    enc.set_color(png::ColorType::Indexed);
+    enc.set_palette(vec![0, 0, 0, 255, 255, 255]);
+    enc.write_header()
+        .unwrap()
+        .write_image_data(&[0, 1, 1, 0])
+        .unwrap();
+    let err = read_mosaic(&path).unwrap_err();
+    assert!(
+        matches!(&err, Error::ColorType { found, .. } if found.starts_with("Indexed")),
+        "{err}"
+    );
+}
+
+#[test]
 fn four_bit_and_one_bit_gray_are_bit_depth_errors() {
     let dir = tempfile::tempdir().unwrap();
     for (depth, bits) in [(png::BitDepth::Four, 4), (png::BitDepth::One, 1)] {

@@ -1,0 +1,347 @@
+//! The sample directory of `conventions.md`: `meta.json` (required) plus optional `raw.png`,
+//! `stokes.exr` and `gt/{normal,depth,clear}.exr`, `gt/{material,transparent}.png`.
+//! Reading checks every file against the format's rules and that all images share one size;
+//! writing checks the same, then writes the whole directory atomically.
+
+use std::path::{Path, PathBuf};
+
+use polar_image::{Gray, Image, StokesImage};
+use serde_json::{Map, Value};
+
+use crate::atomic::{temp_sibling, write_file_atomic};
+use crate::error::{Error, Result};
+use crate::png::{
+    GrayPng, check_mosaic_size, read_gray8_png, read_mosaic, write_gray_png, write_gray8_png,
+};
+use crate::validate::{Rule, Validation, check_channels, check_stokes, check_u8};
+use crate::{RGB_CHANNELS, STOKES_CHANNELS, Y_CHANNEL, read_exr, write_exr};
+
+/// File names inside a sample directory, relative to it.
+pub mod files {
+    /// What produced the sample (JSON object). The only required file.
+    pub const META: &str = "meta.json";
+    /// Grayscale mosaic, 8- or 16-bit, linear DN.
+    pub const RAW: &str = "raw.png";
+    /// Float32 S0, S1, S2, S3 in the camera frame.
+    pub const STOKES: &str = "stokes.exr";
+    /// Float32 R, G, B: unit camera-frame normal, 0 where no surface.
+    pub const GT_NORMAL: &str = "gt/normal.exr";
+    /// Float32 Y: distance along -z, 0 where no surface.
+    pub const GT_DEPTH: &str = "gt/depth.exr";
+    /// 8-bit labels, see [`crate::material`].
+    pub const GT_MATERIAL: &str = "gt/material.png";
+    /// 8-bit mask: 255 on transparent objects, else 0.
+    pub const GT_TRANSPARENT: &str = "gt/transparent.png";
+    /// Float32 Y: S0 of the same view without the participating medium.
+    pub const GT_CLEAR: &str = "gt/clear.exr";
+}
+
+/// Labels of `gt/material.png`.
+pub mod material {
+    /// Background: floors, walls, sky (excluded from accuracy figures).
+    pub const BACKGROUND: u8 = 0;
+    /// Opaque dielectric.
+    pub const DIELECTRIC: u8 = 1;
+    /// Metal.
+    pub const METAL: u8 = 2;
+    /// Transparent object.
+    pub const TRANSPARENT: u8 = 3;
+}
+
+/// Value of `gt/transparent.png` on transparent objects (0 elsewhere).
+pub const TRANSPARENT_MASK_ON: u8 = 255;
+
+/// Ground-truth images of a sample; each is optional.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GroundTruth {
+    /// `gt/normal.exr`.
+    pub normal: Option<Image<f32, 3>>,
+    /// `gt/depth.exr`.
+    pub depth: Option<Gray<f32>>,
+    /// `gt/material.png`.
+    pub material: Option<Gray<u8>>,
+    /// `gt/transparent.png`.
+    pub transparent: Option<Gray<u8>>,
+    /// `gt/clear.exr`.
+    pub clear: Option<Gray<f32>>,
+}
+
+/// One sample directory in memory.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sample {
+    /// `meta.json`: size, sensor, camera, scene, renderer, spp, seconds, and any other keys.
+    pub meta: Map<String, Value>,
+    /// `raw.png`, with the bit depth it is stored at.
+    pub raw: Option<GrayPng>,
+    /// `stokes.exr`.
+    pub stokes: Option<StokesImage>,
+    /// `gt/`.
+    pub gt: GroundTruth,
+}
+
+/// Reads a sample directory, checking values (see [`read_sample_with`]).
+pub fn read_sample(dir: impl AsRef<Path>) -> Result<Sample> {
+    read_sample_with(dir, Validation::Check)
+}
+
+/// Reads a sample directory. `meta.json` must exist and hold a JSON object; every other file
+/// is read if present. With [`Validation::Check`]: S0 finite and `>= 0`, S1..S3, normals,
+/// depth and clear S0 finite (depth and clear also `>= 0`), material labels in 0..=3, the
+/// transparency mask 0 or 255. Mosaic size and equal sizes across files are always checked.
+pub fn read_sample_with(dir: impl AsRef<Path>, validation: Validation) -> Result<Sample> {
+    let dir = dir.as_ref();
+    if !dir.is_dir() {
+        return Err(Error::NotFound {
+            path: dir.to_owned(),
+        });
+    }
+    let meta = read_meta(&dir.join(files::META))?;
+    let opt = |name: &str| optional(dir.join(name));
+    let sample = Sample {
+        meta,
+        raw: opt(files::RAW)?.map(read_mosaic).transpose()?,
+        stokes: opt(files::STOKES)?
+            .map(|p| read_exr(p, STOKES_CHANNELS))
+            .transpose()?,
+        gt: GroundTruth {
+            normal: opt(files::GT_NORMAL)?
+                .map(|p| read_exr(p, RGB_CHANNELS))
+                .transpose()?,
+            depth: opt(files::GT_DEPTH)?
+                .map(|p| read_exr(p, Y_CHANNEL))
+                .transpose()?,
+            material: opt(files::GT_MATERIAL)?.map(read_gray8_png).transpose()?,
+            transparent: opt(files::GT_TRANSPARENT)?
+                .map(read_gray8_png)
+                .transpose()?,
+            clear: opt(files::GT_CLEAR)?
+                .map(|p| read_exr(p, Y_CHANNEL))
+                .transpose()?,
+        },
+    };
+    check_sample(dir, &sample, validation)?;
+    Ok(sample)
+}
+
+/// Writes `sample` as the directory `dir` (parents are created), after the checks of
+/// [`read_sample_with`] with [`Validation::Check`]. Atomic: the files go to a temporary
+/// sibling directory that then replaces `dir`, so `dir` is never seen half-written.
+pub fn write_sample(dir: impl AsRef<Path>, sample: &Sample) -> Result<()> {
+    let dir = dir.as_ref();
+    check_sample(dir, sample, Validation::Check)?;
+    if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, "directory", e))?;
+    }
+    let tmp = temp_sibling(dir);
+    let result = write_sample_files(&tmp, sample).and_then(|()| replace_dir(&tmp, dir));
+    if result.is_err() {
+        // Best effort: the temporary directory may be partly written or absent.
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
+}
+
+/// Writes any serializable value as pretty JSON (e.g. `metrics.json`), atomically.
+pub fn write_json(path: impl AsRef<Path>, value: &impl serde::Serialize) -> Result<()> {
+    let path = path.as_ref();
+    let mut text = serde_json::to_vec_pretty(value).map_err(|source| Error::JsonWrite {
+        path: path.to_owned(),
+        source,
+    })?;
+    text.push(b'\n');
+    write_file_atomic(path, |w| {
+        std::io::Write::write_all(w, &text).map_err(|e| Error::io(path, "JSON", e))
+    })
+}
+
+/// Reads a JSON file into any deserializable type.
+pub fn read_json<T: serde::de::DeserializeOwned>(path: impl AsRef<Path>) -> Result<T> {
+    let path = path.as_ref();
+    let text = std::fs::read(path).map_err(|e| Error::io(path, "JSON", e))?;
+    serde_json::from_slice(&text).map_err(|e| Error::corrupt(path, "JSON", e))
+}
+
+fn read_meta(path: &Path) -> Result<Map<String, Value>> {
+    match read_json::<Value>(path)? {
+        Value::Object(map) => Ok(map),
+        other => Err(Error::MetaNotObject {
+            path: path.to_owned(),
+            found: json_type(&other),
+        }),
+    }
+}
+
+fn json_type(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+/// `Some(path)` if the file exists, `None` if not; other failures (permissions) are errors.
+fn optional(path: PathBuf) -> Result<Option<PathBuf>> {
+    match path.try_exists() {
+        Ok(true) => Ok(Some(path)),
+        Ok(false) => Ok(None),
+        Err(e) => Err(Error::io(&path, "sample", e)),
+    }
+}
+
+/// The value rules and the one-size rule; `dir` only names files in errors.
+fn check_sample(dir: &Path, s: &Sample, validation: Validation) -> Result<()> {
+    let gt = &s.gt;
+    let mut sizes = SizeCheck::default();
+    if let Some(raw) = &s.raw {
+        let path = dir.join(files::RAW);
+        check_mosaic_size(&path, raw.image.width(), raw.image.height())?;
+        sizes.add(path, raw.image.size())?;
+    }
+    let other_files = [
+        (files::STOKES, s.stokes.as_ref().map(Image::size)),
+        (files::GT_NORMAL, gt.normal.as_ref().map(Image::size)),
+        (files::GT_DEPTH, gt.depth.as_ref().map(Image::size)),
+        (files::GT_MATERIAL, gt.material.as_ref().map(Image::size)),
+        (
+            files::GT_TRANSPARENT,
+            gt.transparent.as_ref().map(Image::size),
+        ),
+        (files::GT_CLEAR, gt.clear.as_ref().map(Image::size)),
+    ];
+    for (name, size) in other_files {
+        if let Some(size) = size {
+            sizes.add(dir.join(name), size)?;
+        }
+    }
+    if validation == Validation::Check {
+        check_values(dir, s)?;
+    }
+    Ok(())
+}
+
+fn check_values(dir: &Path, s: &Sample) -> Result<()> {
+    use Rule::{Finite, FiniteNonNegative};
+    let gt = &s.gt;
+    if let Some(stokes) = &s.stokes {
+        check_stokes(&dir.join(files::STOKES), stokes)?;
+    }
+    if let Some(normal) = &gt.normal {
+        check_channels(
+            &dir.join(files::GT_NORMAL),
+            normal,
+            RGB_CHANNELS,
+            [Finite; 3],
+        )?;
+    }
+    for (name, image) in [(files::GT_DEPTH, &gt.depth), (files::GT_CLEAR, &gt.clear)] {
+        if let Some(image) = image {
+            check_channels(&dir.join(name), image, Y_CHANNEL, [FiniteNonNegative])?;
+        }
+    }
+    if let Some(m) = &gt.material {
+        check_u8(&dir.join(files::GT_MATERIAL), m, "a label 0..=3", |v| {
+            v <= material::TRANSPARENT
+        })?;
+    }
+    if let Some(t) = &gt.transparent {
+        check_u8(&dir.join(files::GT_TRANSPARENT), t, "0 or 255", |v| {
+            v == 0 || v == TRANSPARENT_MASK_ON
+        })?;
+    }
+    Ok(())
+}
+
+/// Remembers the first image size seen and reports any later one that differs.
+#[derive(Default)]
+struct SizeCheck {
+    first: Option<(PathBuf, (usize, usize))>,
+}
+
+impl SizeCheck {
+    fn add(&mut self, path: PathBuf, size: (usize, usize)) -> Result<()> {
+        match &self.first {
+            None => {
+                self.first = Some((path, size));
+                Ok(())
+            }
+            Some((_, expected)) if *expected == size => Ok(()),
+            Some((reference, expected)) => Err(Error::SizeMismatch {
+                path,
+                found: size,
+                expected: *expected,
+                reference: reference.clone(),
+            }),
+        }
+    }
+}
+
+fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
+    let gt = &s.gt;
+    let has_gt = gt.normal.is_some()
+        || gt.depth.is_some()
+        || gt.material.is_some()
+        || gt.transparent.is_some()
+        || gt.clear.is_some();
+    let mkdir = |p: &Path| std::fs::create_dir(p).map_err(|e| Error::io(p, "directory", e));
+    mkdir(tmp)?;
+    if has_gt {
+        mkdir(&tmp.join("gt"))?;
+    }
+    write_json(tmp.join(files::META), &s.meta)?;
+    let p = |name: &str| tmp.join(name);
+    if let Some(raw) = &s.raw {
+        write_gray_png(p(files::RAW), raw)?;
+    }
+    if let Some(stokes) = &s.stokes {
+        write_exr(p(files::STOKES), stokes, STOKES_CHANNELS)?;
+    }
+    if let Some(normal) = &gt.normal {
+        write_exr(p(files::GT_NORMAL), normal, RGB_CHANNELS)?;
+    }
+    for (name, image) in [(files::GT_DEPTH, &gt.depth), (files::GT_CLEAR, &gt.clear)] {
+        if let Some(image) = image {
+            write_exr(p(name), image, Y_CHANNEL)?;
+        }
+    }
+    for (name, image) in [
+        (files::GT_MATERIAL, &gt.material),
+        (files::GT_TRANSPARENT, &gt.transparent),
+    ] {
+        if let Some(image) = image {
+            write_gray8_png(p(name), image)?;
+        }
+    }
+    Ok(())
+}
+
+/// Moves the finished directory `new` to `dir`. An existing `dir` is first moved aside and
+/// removed only after the swap, so a failure leaves either the old or the new sample.
+fn replace_dir(new: &Path, dir: &Path) -> Result<()> {
+    let rename = |from: &Path, to: &Path| {
+        std::fs::rename(from, to).map_err(|e| Error::io(dir, "directory", e))
+    };
+    if !dir.exists() {
+        return rename(new, dir);
+    }
+    if !dir.is_dir() {
+        let source = std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            "exists and is not a directory",
+        );
+        return Err(Error::Io {
+            path: dir.to_owned(),
+            source,
+        });
+    }
+    let old = temp_sibling(dir);
+    rename(dir, &old)?;
+    if let Err(e) = rename(new, dir) {
+        // Put the old sample back; if even that fails, the error below still names `dir`.
+        let _ = std::fs::rename(&old, dir);
+        return Err(e);
+    }
+    std::fs::remove_dir_all(&old).map_err(|e| Error::io(&old, "directory", e))
+}
