@@ -5,7 +5,6 @@
 //! match `cv2.GaussianBlur`/`cv2.Sobel`, which reflect (`BORDER_REFLECT_101`).
 
 use polar_image::Gray;
-use rayon::prelude::*;
 
 use crate::{BAND_ROWS, Border, Error, same_size};
 
@@ -106,38 +105,54 @@ pub fn sep_filter(
     let (rx, ry) = (kx.len() / 2, ky.len() / 2);
     let rows = band_rows(ry);
     let s = src.as_slice();
-    dst.as_mut_slice()
-        .par_chunks_mut(w * rows)
-        .enumerate()
-        .for_each(|(b, out)| {
-            let y0 = b * rows;
+    crate::par_bands(
+        dst.as_mut_slice(),
+        w,
+        rows,
+        |y0, out, sc: &mut (Vec<f32>, Vec<f32>)| {
             let n_out = out.len() / w;
-            let mut pad = vec![0.0f32; w + 2 * rx];
-            let mut tmp = vec![0.0f32; (n_out + 2 * ry) * w];
+            let pad = crate::scratch(&mut sc.0, w + 2 * rx, 0.0);
+            let tmp = crate::scratch(&mut sc.1, (n_out + 2 * ry) * w, 0.0);
             for (t, trow) in tmp.chunks_exact_mut(w).enumerate() {
                 let y = border.index((y0 + t) as isize - ry as isize, h);
-                border.pad_row(&s[y * w..(y + 1) * w], rx, &mut pad);
-                correlate_row(&pad, kx, trow);
+                border.pad_row(&s[y * w..(y + 1) * w], rx, pad);
+                let pad: &[f32] = pad;
+                correlate(kx, |i| &pad[i..i + w], trow);
             }
+            let tmp: &[f32] = tmp;
             for (r, orow) in out.chunks_exact_mut(w).enumerate() {
-                orow.fill(0.0);
-                for (j, &k) in ky.iter().enumerate() {
-                    let t = &tmp[(r + j) * w..(r + j + 1) * w];
-                    orow.iter_mut().zip(t).for_each(|(o, v)| *o += k * v);
-                }
+                correlate(ky, |j| &tmp[(r + j) * w..(r + j + 1) * w], orow);
             }
-        });
+        },
+    );
     Ok(())
 }
 
-/// `out[x] = sum_i k[i] pad[x + i]`, written tap-major so the inner loop vectorises.
-fn correlate_row(pad: &[f32], k: &[f32], out: &mut [f32]) {
+/// `out = sum_i k[i] tap(i)` over equal-length slices, tap-major so the inner loops
+/// vectorise. Symmetric kernels (Gaussian, smoothers) and antisymmetric ones (first
+/// derivatives) fold pairs of taps first, halving the multiplications.
+fn correlate<'a>(k: &[f32], tap: impl Fn(usize) -> &'a [f32], out: &mut [f32]) {
+    let n = k.len();
+    let r = n / 2;
+    let symmetric = (0..r).all(|i| k[i] == k[n - 1 - i]);
+    let antisymmetric = k[r] == 0.0 && (0..r).all(|i| k[i] == -k[n - 1 - i]);
+    if symmetric || antisymmetric {
+        let kr = k[r];
+        out.iter_mut().zip(tap(r)).for_each(|(o, &v)| *o = kr * v);
+        for (i, &ki) in k[..r].iter().enumerate() {
+            let (a, b) = (tap(i), tap(n - 1 - i));
+            let pairs = out.iter_mut().zip(a.iter().zip(b));
+            if symmetric {
+                pairs.for_each(|(o, (&a, &b))| *o += ki * (a + b));
+            } else {
+                pairs.for_each(|(o, (&a, &b))| *o += ki * (a - b));
+            }
+        }
+        return;
+    }
     out.fill(0.0);
-    let w = out.len();
     for (i, &ki) in k.iter().enumerate() {
-        out.iter_mut()
-            .zip(&pad[i..i + w])
-            .for_each(|(o, p)| *o += ki * p);
+        out.iter_mut().zip(tap(i)).for_each(|(o, &v)| *o += ki * v);
     }
 }
 
@@ -167,25 +182,21 @@ pub fn box_filter(
     let scale = 1.0 / (kw * kh) as f64;
     let rows = band_rows(ry);
     let s = src.as_slice();
-    dst.as_mut_slice()
-        .par_chunks_mut(w * rows)
-        .enumerate()
-        .for_each(|(b, out)| {
-            let y0 = b * rows;
+    crate::par_bands(
+        dst.as_mut_slice(),
+        w,
+        rows,
+        |y0, out, sc: &mut (Vec<f32>, Vec<f64>, Vec<f64>)| {
             let n_out = out.len() / w;
-            let mut pad = vec![0.0f32; w + 2 * rx];
-            let mut tmp = vec![0.0f64; (n_out + 2 * ry) * w];
+            let pad = crate::scratch(&mut sc.0, w + 2 * rx, 0.0);
+            let tmp = crate::scratch(&mut sc.1, (n_out + 2 * ry) * w, 0.0);
             for (t, trow) in tmp.chunks_exact_mut(w).enumerate() {
                 let y = border.index((y0 + t) as isize - ry as isize, h);
-                border.pad_row(&s[y * w..(y + 1) * w], rx, &mut pad);
-                let mut acc: f64 = pad[..kw].iter().map(|&v| f64::from(v)).sum();
-                trow[0] = acc;
-                for x in 1..w {
-                    acc += f64::from(pad[x + kw - 1]) - f64::from(pad[x - 1]);
-                    trow[x] = acc;
-                }
+                border.pad_row(&s[y * w..(y + 1) * w], rx, pad);
+                row_box_sum(pad, kw, trow);
             }
-            let mut col: Vec<f64> = tmp[..w].to_vec();
+            let col = crate::scratch(&mut sc.2, w, 0.0);
+            col.copy_from_slice(&tmp[..w]);
             for j in 1..kh {
                 col.iter_mut()
                     .zip(&tmp[j * w..(j + 1) * w])
@@ -193,7 +204,7 @@ pub fn box_filter(
             }
             for (r, orow) in out.chunks_exact_mut(w).enumerate() {
                 orow.iter_mut()
-                    .zip(&col)
+                    .zip(col.iter())
                     .for_each(|(o, c)| *o = (c * scale) as f32);
                 if r + 1 < n_out {
                     let (add, sub) = (
@@ -205,8 +216,49 @@ pub fn box_filter(
                     }
                 }
             }
-        });
+        },
+    );
     Ok(())
+}
+
+/// Sums of `kw` consecutive values of `pad` in `f64`: `out[x] = sum(pad[x .. x + kw])`.
+/// Short windows add the taps directly (vectorised); long ones keep running sums in four
+/// interleaved segments so that the add/subtract chains overlap in the pipeline.
+fn row_box_sum(pad: &[f32], kw: usize, out: &mut [f64]) {
+    let w = out.len();
+    if kw <= 9 {
+        out.iter_mut()
+            .zip(pad)
+            .for_each(|(o, &p)| *o = f64::from(p));
+        for i in 1..kw {
+            out.iter_mut()
+                .zip(&pad[i..i + w])
+                .for_each(|(o, &p)| *o += f64::from(p));
+        }
+        return;
+    }
+    const SEG: usize = 4;
+    let seg = w.div_ceil(SEG);
+    let start = |j: usize| (j * seg).min(w);
+    let mut acc = [0.0f64; SEG];
+    for (j, a) in acc.iter_mut().enumerate() {
+        *a = pad[start(j)..start(j) + kw]
+            .iter()
+            .map(|&v| f64::from(v))
+            .sum();
+    }
+    for i in 0..seg {
+        for (j, a) in acc.iter_mut().enumerate() {
+            let x = start(j) + i;
+            if x >= start(j + 1) {
+                continue;
+            }
+            if i > 0 {
+                *a += f64::from(pad[x + kw - 1]) - f64::from(pad[x - 1]);
+            }
+            out[x] = *a;
+        }
+    }
 }
 
 /// The derivative / smoothing kernel pair of `cv::getDerivKernels(dx, dy, ksize)`

@@ -89,6 +89,29 @@ pub(crate) fn same_size<T, U, const C: usize, const D: usize>(
     Ok(())
 }
 
+/// Runs `f(first_row, band, scratch)` over bands of `rows` image rows of `dst` (row
+/// width `w`) in parallel. Scratch buffers are reused across the bands of one rayon job
+/// instead of being allocated per band.
+pub(crate) fn par_bands<T: Send, S: Default>(
+    dst: &mut [T],
+    w: usize,
+    rows: usize,
+    f: impl Fn(usize, &mut [T], &mut S) + Sync + Send,
+) {
+    use rayon::prelude::*;
+    dst.par_chunks_mut(w * rows)
+        .enumerate()
+        .for_each_init(S::default, |s, (b, out)| f(b * rows, out, s));
+}
+
+/// The first `n` elements of `v`, growing it (with `fill`) if needed; old contents stay.
+pub(crate) fn scratch<T: Clone>(v: &mut Vec<T>, n: usize, fill: T) -> &mut [T] {
+    if v.len() < n {
+        v.resize(n, fill);
+    }
+    &mut v[..n]
+}
+
 /// Rows per rayon task: big enough to amortise the halo rows a band recomputes,
 /// small enough to keep a band's scratch in L2 and both cores busy.
 pub(crate) const BAND_ROWS: usize = 32;

@@ -13,8 +13,7 @@ use rayon::prelude::*;
 
 use crate::{Border, Error, filter::band_rows, same_size};
 
-/// One step of a selection network on value slots `a < b` (in sorted order, `a` gets
-/// the smaller value).
+/// One step of a comparator network on value slots (`a` gets the smaller value).
 #[derive(Clone, Copy, Debug)]
 enum Step {
     /// `a, b = min(a, b), max(a, b)`.
@@ -25,19 +24,27 @@ enum Step {
     Max(usize, usize),
 }
 
-/// A pruned network selecting the median of `n` values, and the slot that ends up holding it.
-fn median_network(n: usize) -> (Vec<Step>, usize) {
+/// Batcher's odd-even merge sort for `n` values, with the wires beyond `n` (padding to a
+/// power of two) holding +inf folded away: comparators as slot pairs, and the slot that
+/// ends at each sorted position.
+fn batcher(n: usize) -> (Vec<(usize, usize)>, Vec<usize>) {
     let size = n.next_power_of_two();
-    let mut comparators = Vec::new();
+    let mut wire: Vec<Option<usize>> = (0..size).map(|i| (i < n).then_some(i)).collect();
+    let mut ops = Vec::new();
     let mut p = 1;
     while p < size {
         let mut k = p;
         while k >= 1 {
             let mut j = k % p;
             while j + k < size {
-                for i in 0..k.min(size - j - k) {
-                    if (i + j) / (2 * p) == (i + j + k) / (2 * p) {
-                        comparators.push((i + j, i + j + k));
+                for i in
+                    (0..k.min(size - j - k)).filter(|i| (i + j) / (2 * p) == (i + j + k) / (2 * p))
+                {
+                    let (a, b) = (i + j, i + j + k);
+                    match (wire[a], wire[b]) {
+                        (Some(sa), Some(sb)) => ops.push((sa, sb)),
+                        (None, Some(_)) => wire.swap(a, b),
+                        _ => {}
                     }
                 }
                 j += 2 * k;
@@ -46,22 +53,46 @@ fn median_network(n: usize) -> (Vec<Step>, usize) {
         }
         p *= 2;
     }
-    // Wires beyond n carry +inf: fold them away, keeping only real slot exchanges.
-    let mut wire: Vec<Option<usize>> = (0..size).map(|i| (i < n).then_some(i)).collect();
-    let mut ops = Vec::new();
-    for (a, b) in comparators {
-        match (wire[a], wire[b]) {
-            (Some(sa), Some(sb)) => ops.push((sa, sb)),
-            (None, Some(_)) => wire.swap(a, b),
-            _ => {}
+    (ops, wire.into_iter().flatten().collect())
+}
+
+/// The median of a `k x k` window whose `k` columns (slots `c * k .. c * k + k`) are
+/// already sorted: Batcher's network minus every comparator that never swaps under that
+/// precondition (checked on all 0/1 inputs with sorted columns, which suffices by the
+/// 0-1 principle) and minus everything the middle output does not depend on.
+fn sorted_columns_median_network(k: usize) -> (Vec<Step>, usize) {
+    let n = k * k;
+    let (ops, sorted) = batcher(n);
+    // Bit i of slot s's bitset = value of slot s in 0/1 input number i; input i sets the
+    // top (k - digit_c) entries of column c to 1, digit_c = c-th base-(k+1) digit of i.
+    let inputs = (k + 1).pow(k as u32);
+    let words = inputs.div_ceil(64);
+    let mut bits = vec![vec![0u64; words]; n];
+    for i in 0..inputs {
+        let mut rest = i;
+        for c in 0..k {
+            let zeros = rest % (k + 1);
+            rest /= k + 1;
+            for r in zeros..k {
+                bits[c * k + r][i / 64] |= 1 << (i % 64);
+            }
         }
     }
-    let out = wire[n / 2].unwrap_or(0);
-    // Backward pass: keep only what the output depends on.
+    let mut live = Vec::new();
+    for (a, b) in ops {
+        if bits[a].iter().zip(&bits[b]).any(|(x, y)| x & !y != 0) {
+            let (sa, sb) = two_slots(&mut bits, 1, a, b);
+            for (x, y) in sa[0].iter_mut().zip(sb[0].iter_mut()) {
+                (*x, *y) = (*x & *y, *x | *y);
+            }
+            live.push((a, b));
+        }
+    }
+    let out = sorted[n / 2];
     let mut needed = vec![false; n];
     needed[out] = true;
     let mut steps = Vec::new();
-    for &(a, b) in ops.iter().rev() {
+    for &(a, b) in live.iter().rev() {
         let step = match (needed[a], needed[b]) {
             (true, true) => Step::Exchange(a, b),
             (true, false) => Step::Min(a, b),
@@ -81,8 +112,8 @@ trait Lane: Copy + Default + Send + Sync + PartialOrd {}
 impl Lane for f32 {}
 impl Lane for u8 {}
 
-/// Pixels processed per network evaluation (all slots stay in L1).
-const CHUNK: usize = 64;
+/// Pixels per network evaluation (all slots stay in L1).
+const CHUNK: usize = 128;
 
 fn lo<T: Lane>(a: T, b: T) -> T {
     if b < a { b } else { a }
@@ -92,75 +123,131 @@ fn hi<T: Lane>(a: T, b: T) -> T {
     if b < a { a } else { b }
 }
 
-fn apply<T: Lane>(steps: &[Step], slots: &mut [[T; CHUNK]]) {
+/// Two distinct slots of length `len` of a flat buffer, mutably.
+fn two_slots<T>(buf: &mut [T], len: usize, a: usize, b: usize) -> (&mut [T], &mut [T]) {
+    if a < b {
+        let (x, y) = buf.split_at_mut(b * len);
+        (&mut x[a * len..(a + 1) * len], &mut y[..len])
+    } else {
+        let (x, y) = buf.split_at_mut(a * len);
+        (&mut y[..len], &mut x[b * len..(b + 1) * len])
+    }
+}
+
+/// Runs the network over slots of length `len` stored back to back in `buf`.
+fn apply<T: Lane>(steps: &[Step], buf: &mut [T], len: usize) {
     for &s in steps {
-        let (a, b) = match s {
-            Step::Exchange(a, b) | Step::Min(a, b) | Step::Max(a, b) => (a, b),
-        };
-        let Ok([sa, sb]) = slots.get_disjoint_mut([a, b]) else {
-            continue;
-        };
         match s {
-            Step::Exchange(..) => sa.iter_mut().zip(sb.iter_mut()).for_each(|(x, y)| {
-                let (l, h) = (lo(*x, *y), hi(*x, *y));
-                *x = l;
-                *y = h;
-            }),
-            Step::Min(..) => sa
-                .iter_mut()
-                .zip(sb.iter())
-                .for_each(|(x, &y)| *x = lo(*x, y)),
-            Step::Max(..) => sb
-                .iter_mut()
-                .zip(sa.iter())
-                .for_each(|(y, &x)| *y = hi(x, *y)),
+            Step::Exchange(a, b) => {
+                let (sa, sb) = two_slots(buf, len, a, b);
+                sa.iter_mut().zip(sb.iter_mut()).for_each(|(x, y)| {
+                    let (l, h) = (lo(*x, *y), hi(*x, *y));
+                    *x = l;
+                    *y = h;
+                });
+            }
+            Step::Min(a, b) => {
+                let (sa, sb) = two_slots(buf, len, a, b);
+                sa.iter_mut()
+                    .zip(sb.iter())
+                    .for_each(|(x, &y)| *x = lo(*x, y));
+            }
+            Step::Max(a, b) => {
+                let (sa, sb) = two_slots(buf, len, a, b);
+                sb.iter_mut()
+                    .zip(sa.iter())
+                    .for_each(|(y, &x)| *y = hi(x, *y));
+            }
         }
     }
 }
 
-fn network(ksize: usize) -> &'static (Vec<Step>, usize) {
-    static N3: OnceLock<(Vec<Step>, usize)> = OnceLock::new();
-    static N5: OnceLock<(Vec<Step>, usize)> = OnceLock::new();
-    if ksize == 3 {
-        N3.get_or_init(|| median_network(9))
-    } else {
-        N5.get_or_init(|| median_network(25))
-    }
+/// Networks for a `k x k` median: sort a column of `k`, then the sorted-columns median.
+struct Networks {
+    column: Vec<Step>,
+    column_order: Vec<usize>,
+    median: Vec<Step>,
+    out: usize,
 }
 
-/// Median by selection network for `ksize` 3 or 5, replicate border.
+fn networks(ksize: usize) -> &'static Networks {
+    static N: [OnceLock<Networks>; 2] = [OnceLock::new(), OnceLock::new()];
+    N[usize::from(ksize == 5)].get_or_init(|| {
+        let (col, order) = batcher(ksize);
+        let (median, out) = sorted_columns_median_network(ksize);
+        Networks {
+            column: col.into_iter().map(|(a, b)| Step::Exchange(a, b)).collect(),
+            column_order: order,
+            median,
+            out,
+        }
+    })
+}
+
+/// Median by selection network for `ksize` 3 or 5, replicate border: each output row
+/// first sorts every column of its `ksize` source rows (shared by `ksize` outputs), then
+/// runs the pruned sorted-columns network on runs of `CHUNK` pixels.
 fn median_small<T: Lane>(src: &Gray<T>, dst: &mut Gray<T>, ksize: usize) {
     let (w, h) = src.size();
     let r = ksize / 2;
-    let (steps, out_slot) = network(ksize);
+    let net = networks(ksize);
     let rows = band_rows(r);
     let s = src.as_slice();
-    dst.as_mut_slice()
-        .par_chunks_mut(w * rows)
-        .enumerate()
-        .for_each(|(b, out)| {
-            let y0 = b * rows;
+    let pw = w + 2 * r;
+    crate::par_bands(
+        dst.as_mut_slice(),
+        w,
+        rows,
+        |y0, out, sc: &mut [Vec<T>; 3]| {
             let n_out = out.len() / w;
-            let pw = w + 2 * r;
-            let mut padded = vec![T::default(); (n_out + 2 * r) * pw];
+            let [sp, sc_cols, sc_slots] = sc;
+            let padded = crate::scratch(sp, (n_out + 2 * r) * pw, T::default());
             for (t, prow) in padded.chunks_exact_mut(pw).enumerate() {
                 let y = Border::Replicate.index((y0 + t) as isize - r as isize, h);
                 Border::Replicate.pad_row(&s[y * w..(y + 1) * w], r, prow);
             }
-            let mut slots = vec![[T::default(); CHUNK]; ksize * ksize];
+            let cols = crate::scratch(sc_cols, ksize * pw, T::default());
+            let slots = crate::scratch(sc_slots, ksize * ksize * CHUNK, T::default());
             for (row, orow) in out.chunks_exact_mut(w).enumerate() {
+                cols.copy_from_slice(&padded[row * pw..(row + ksize) * pw]);
+                apply(&net.column, cols, pw);
+                if ksize == 3 {
+                    median3_of_sorted_columns(cols, pw, &net.column_order, orow);
+                    continue;
+                }
                 for x0 in (0..w).step_by(CHUNK) {
                     let m = CHUNK.min(w - x0);
-                    for (k, slot) in slots.iter_mut().enumerate() {
-                        let (dy, dx) = (k / ksize, k % ksize);
-                        let start = (row + dy) * pw + x0 + dx;
-                        slot[..m].copy_from_slice(&padded[start..start + m]);
+                    for c in 0..ksize {
+                        for (rank, &slot) in net.column_order.iter().enumerate() {
+                            let start = slot * pw + x0 + c;
+                            let dst = (c * ksize + rank) * CHUNK;
+                            slots[dst..dst + m].copy_from_slice(&cols[start..start + m]);
+                        }
                     }
-                    apply(steps, &mut slots);
-                    orow[x0..x0 + m].copy_from_slice(&slots[*out_slot][..m]);
+                    apply(&net.median, slots, CHUNK);
+                    orow[x0..x0 + m].copy_from_slice(&slots[net.out * CHUNK..net.out * CHUNK + m]);
                 }
             }
-        });
+        },
+    );
+}
+
+/// 3x3 median from sorted columns (`lo <= mid <= hi` per column):
+/// `med3(max(lo), med3(mid), min(hi))` over three neighbouring columns, a classic
+/// identity (e.g. Paeth, Graphics Gems 1990) that needs no copies.
+fn median3_of_sorted_columns<T: Lane>(cols: &[T], pw: usize, order: &[usize], out: &mut [T]) {
+    let w = out.len();
+    let row = |rank: usize, dx: usize| &cols[order[rank] * pw + dx..order[rank] * pw + dx + w];
+    let med3 = |a: T, b: T, c: T| hi(lo(a, b), lo(hi(a, b), c));
+    let (l0, l1, l2) = (row(0, 0), row(0, 1), row(0, 2));
+    let (m0, m1, m2) = (row(1, 0), row(1, 1), row(1, 2));
+    let (h0, h1, h2) = (row(2, 0), row(2, 1), row(2, 2));
+    for x in 0..w {
+        let a = hi(hi(l0[x], l1[x]), l2[x]);
+        let b = med3(m0[x], m1[x], m2[x]);
+        let c = lo(lo(h0[x], h1[x]), h2[x]);
+        out[x] = med3(a, b, c);
+    }
 }
 
 /// Median by sliding 256-bin histogram for `u8` images, replicate border.
@@ -264,38 +351,29 @@ pub fn median_blur_u8(src: &Gray<u8>, dst: &mut Gray<u8>, ksize: usize) -> Resul
 mod tests {
     use super::*;
 
-    /// Exhaustive 0-1 principle: a comparator network selects the median of every input
-    /// iff it does so for every 0/1 input; 2^9 cases for 3x3, and random ones for 5x5.
+    /// Median of random windows (columns sorted first, as `median_small` does), 3x3 and 5x5,
+    /// with many ties (values 0..16).
     #[test]
-    fn network_selects_the_median() {
-        let (steps, out) = median_network(9);
-        for bits in 0u32..512 {
-            let mut slots = vec![[0u8; CHUNK]; 9];
-            for (i, s) in slots.iter_mut().enumerate() {
-                s[0] = ((bits >> i) & 1) as u8;
-            }
-            apply(&steps, &mut slots);
-            assert_eq!(
-                u32::from(slots[out][0]),
-                u32::from(bits.count_ones() >= 5),
-                "{bits:09b}"
-            );
-        }
-        let (steps, out) = median_network(25);
+    fn sorted_columns_network_selects_the_median() {
         let mut state = 12345u64;
-        for _ in 0..2000 {
-            let mut vals: Vec<u8> = (0..25)
-                .map(|_| {
-                    state = state
-                        .wrapping_mul(6364136223846793005)
-                        .wrapping_add(1442695040888963407);
-                    (state >> 56) as u8
-                })
-                .collect();
-            let mut slots: Vec<[u8; CHUNK]> = vals.iter().map(|&v| [v; CHUNK]).collect();
-            apply(&steps, &mut slots);
-            vals.sort_unstable();
-            assert_eq!(slots[out][0], vals[12]);
+        for k in [3, 5] {
+            let (steps, out) = sorted_columns_median_network(k);
+            eprintln!("{k}x{k} median network: {} steps", steps.len());
+            for _ in 0..3000 {
+                let mut vals: Vec<u8> = (0..k * k)
+                    .map(|_| {
+                        state = state
+                            .wrapping_mul(6364136223846793005)
+                            .wrapping_add(1442695040888963407);
+                        (state >> 60) as u8
+                    })
+                    .collect();
+                vals.chunks_mut(k).for_each(|c| c.sort_unstable());
+                let mut buf = vals.clone();
+                apply(&steps, &mut buf, 1);
+                vals.sort_unstable();
+                assert_eq!(buf[out], vals[k * k / 2]);
+            }
         }
     }
 

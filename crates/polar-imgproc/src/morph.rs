@@ -6,7 +6,6 @@
 //! the image are simply left out of the minimum/maximum.
 
 use polar_image::Gray;
-use rayon::prelude::*;
 
 use crate::{Error, filter::band_rows, same_size};
 
@@ -56,27 +55,32 @@ fn runs(shape: MorphShape, kw: usize, kh: usize) -> Vec<Run> {
         .collect()
 }
 
-/// Which extremum a morphological operation takes.
-#[derive(Clone, Copy)]
-enum Extremum {
-    Min,
-    Max,
+/// Which extremum a morphological operation takes (a type, so the hot loops are
+/// compiled once per extremum without a branch inside).
+trait Pick: Send + Sync {
+    /// The border value that never wins.
+    const NEUTRAL: f32;
+    /// The winner of two values. Plain comparisons (not `f32::min`/`max`) compile to single
+    /// SIMD min/max instructions; NaN inputs give unspecified results, as in OpenCV.
+    fn pick(a: f32, b: f32) -> f32;
 }
 
-impl Extremum {
-    fn pick(self, a: f32, b: f32) -> f32 {
-        match self {
-            Extremum::Min => a.min(b),
-            Extremum::Max => a.max(b),
-        }
-    }
+/// Erosion: minimum.
+struct Min;
+/// Dilation: maximum.
+struct Max;
 
-    /// The border value that never wins.
-    fn neutral(self) -> f32 {
-        match self {
-            Extremum::Min => f32::INFINITY,
-            Extremum::Max => f32::NEG_INFINITY,
-        }
+impl Pick for Min {
+    const NEUTRAL: f32 = f32::INFINITY;
+    fn pick(a: f32, b: f32) -> f32 {
+        if b < a { b } else { a }
+    }
+}
+
+impl Pick for Max {
+    const NEUTRAL: f32 = f32::NEG_INFINITY;
+    fn pick(a: f32, b: f32) -> f32 {
+        if b > a { b } else { a }
     }
 }
 
@@ -91,13 +95,12 @@ fn check_kernel(kw: usize, kh: usize) -> Result<(), Error> {
 }
 
 /// Extremum over the structuring element anchored at its centre; out-of-image pixels ignored.
-fn morph(
+fn morph<P: Pick>(
     src: &Gray<f32>,
     dst: &mut Gray<f32>,
     shape: MorphShape,
     kw: usize,
     kh: usize,
-    ext: Extremum,
 ) -> Result<(), Error> {
     same_size(src, dst)?;
     check_kernel(kw, kh)?;
@@ -114,31 +117,61 @@ fn morph(
         .collect();
     let rows = band_rows(ay.max(kh - 1 - ay));
     let s = src.as_slice();
-    let neutral = ext.neutral();
-    dst.as_mut_slice()
-        .par_chunks_mut(w * rows)
-        .enumerate()
-        .for_each(|(b, out)| {
-            let y0 = b * rows;
+    let neutral = P::NEUTRAL;
+    let rect = all.len() == kh && distinct.len() == 1;
+    let max_len = distinct.iter().map(|d| d.1).max().unwrap_or(1);
+    crate::par_bands(
+        dst.as_mut_slice(),
+        w,
+        rows,
+        |y0, out, sc: &mut [Vec<f32>; 3]| {
             let n_out = out.len() / w;
             let n_tmp = n_out + kh - 1;
-            let mut pad = vec![neutral; w + kw - 1];
+            let [sc_a, sc_b, sc_t] = sc;
+            let (mut cur, mut nxt) = (
+                crate::scratch(sc_a, w + kw - 1, neutral),
+                crate::scratch(sc_b, w + kw - 1, neutral),
+            );
             // tmp[d][t]: horizontal extremum of run d over source row y0 + t - ay.
-            let mut tmp = vec![neutral; distinct.len() * n_tmp * w];
+            let tmp = crate::scratch(sc_t, distinct.len() * n_tmp * w, neutral);
             for t in 0..n_tmp {
                 let Some(y) = (y0 + t).checked_sub(ay).filter(|&y| y < h) else {
+                    for d in 0..distinct.len() {
+                        tmp[(d * n_tmp + t) * w..(d * n_tmp + t + 1) * w].fill(neutral);
+                    }
                     continue;
                 };
-                pad[ax..ax + w].copy_from_slice(&s[y * w..(y + 1) * w]);
-                for (d, &(x0, len)) in distinct.iter().enumerate() {
-                    let o = &mut tmp[(d * n_tmp + t) * w..(d * n_tmp + t + 1) * w];
-                    o.copy_from_slice(&pad[x0..x0 + w]);
-                    for i in 1..len {
-                        o.iter_mut()
-                            .zip(&pad[x0 + i..x0 + i + w])
-                            .for_each(|(a, &v)| *a = ext.pick(*a, v));
+                cur.fill(neutral);
+                cur[ax..ax + w].copy_from_slice(&s[y * w..(y + 1) * w]);
+                // Doubling: at level `span`, cur[x] = extremum of the `span` pixels from x; a
+                // run of length len is two overlapping windows of the largest span <= len.
+                let mut span = 1;
+                loop {
+                    for (d, &(x0, len)) in distinct.iter().enumerate() {
+                        if prev_pow2(len) == span {
+                            let o = &mut tmp[(d * n_tmp + t) * w..(d * n_tmp + t + 1) * w];
+                            let (a, b) =
+                                (&cur[x0..x0 + w], &cur[x0 + len - span..x0 + len - span + w]);
+                            o.iter_mut()
+                                .zip(a.iter().zip(b))
+                                .for_each(|(o, (&a, &b))| *o = P::pick(a, b));
+                        }
                     }
+                    if 2 * span > max_len {
+                        break;
+                    }
+                    let n = cur.len() - span;
+                    nxt[..n]
+                        .iter_mut()
+                        .zip(cur[..n].iter().zip(&cur[span..]))
+                        .for_each(|(o, (&a, &b))| *o = P::pick(a, b));
+                    std::mem::swap(&mut cur, &mut nxt);
+                    span *= 2;
                 }
+            }
+            if rect {
+                vertical_doubling::<P>(tmp, w, n_tmp, kh, out);
+                return;
             }
             for (r, orow) in out.chunks_exact_mut(w).enumerate() {
                 orow.fill(neutral);
@@ -146,11 +179,43 @@ fn morph(
                     let t = &tmp[(d * n_tmp + r + dy) * w..(d * n_tmp + r + dy + 1) * w];
                     orow.iter_mut()
                         .zip(t)
-                        .for_each(|(a, &v)| *a = ext.pick(*a, v));
+                        .for_each(|(a, &v)| *a = P::pick(*a, v));
                 }
             }
-        });
+        },
+    );
     Ok(())
+}
+
+/// Largest power of two `<= n` (`n >= 1`).
+fn prev_pow2(n: usize) -> usize {
+    1 << (usize::BITS - 1 - n.leading_zeros())
+}
+
+/// Vertical extremum over `kh` consecutive rows of `tmp` (`n_tmp` rows of width `w`) into
+/// `out`, by in-place doubling as for the rows.
+fn vertical_doubling<P: Pick>(tmp: &mut [f32], w: usize, n_tmp: usize, kh: usize, out: &mut [f32]) {
+    let p = prev_pow2(kh);
+    let mut span = 1;
+    while span < p {
+        for t in 0..n_tmp - span {
+            let (head, tail) = tmp.split_at_mut((t + span) * w);
+            let dst = &mut head[t * w..(t + 1) * w];
+            dst.iter_mut()
+                .zip(&tail[..w])
+                .for_each(|(a, &b)| *a = P::pick(*a, b));
+        }
+        span *= 2;
+    }
+    for (r, orow) in out.chunks_exact_mut(w).enumerate() {
+        let (a, b) = (
+            &tmp[r * w..(r + 1) * w],
+            &tmp[(r + kh - p) * w..(r + kh - p + 1) * w],
+        );
+        orow.iter_mut()
+            .zip(a.iter().zip(b))
+            .for_each(|(o, (&a, &b))| *o = P::pick(a, b));
+    }
 }
 
 /// Erosion: minimum over the structuring element, matching `cv2.erode(src, kernel)` with
@@ -162,7 +227,7 @@ pub fn erode(
     kw: usize,
     kh: usize,
 ) -> Result<(), Error> {
-    morph(src, dst, shape, kw, kh, Extremum::Min)
+    morph::<Min>(src, dst, shape, kw, kh)
 }
 
 /// Dilation: maximum over the structuring element, matching `cv2.dilate(src, kernel)`
@@ -174,7 +239,7 @@ pub fn dilate(
     kw: usize,
     kh: usize,
 ) -> Result<(), Error> {
-    morph(src, dst, shape, kw, kh, Extremum::Max)
+    morph::<Max>(src, dst, shape, kw, kh)
 }
 
 /// Opening (erosion then dilation), matching `cv2.morphologyEx(src, MORPH_OPEN, kernel)`.
