@@ -15,7 +15,9 @@
 //! ```
 
 use crate::microfacet::Ggx;
-use crate::{Bsdf, Conductor, Dielectric, Error, Lambertian, Plastic, Sheet, SheetKind};
+use crate::{
+    Bsdf, Conductor, Dielectric, Error, Lambertian, Plastic, Polarization, Sheet, SheetKind,
+};
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
@@ -371,6 +373,11 @@ impl Material {
             Material::Conductor(_) => 2,
             Material::Dielectric(_) | Material::Polarizer(_) | Material::Retarder(_) => 3,
         }
+    }
+
+    /// The cheapest exact transport model the material needs (the same at every `uv`).
+    pub fn polarization(&self) -> Polarization {
+        self.bsdf([0.5, 0.5]).polarization()
     }
 
     /// The BSDF at surface coordinates `uv` (call [`Self::validate`] once first).
