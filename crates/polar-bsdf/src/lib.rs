@@ -17,6 +17,13 @@
 //! - Opaque materials (conductor, plastic, Lambertian) are one-sided: zero unless
 //!   `wo.z > 0` and `wi.z > 0`. A renderer that wants two-sided opaque surfaces
 //!   flips the shading frame (z and y) toward `wo` before calling.
+//!
+//! # Matching Mitsuba 3 (for the cross-check)
+//! Masking–shadowing is Smith's separable `G1(wo) G1(wi)` and roughness is
+//! GGX `alpha` as in Mitsuba; set `distribution = "ggx"` there (its default is
+//! Beckmann), `ext_ior = 1` (its default is air, 1.000277), and pass conductor
+//! presets as explicit `eta`/`k` (the values in [`Metal`]). [`Plastic`] is
+//! `pplastic` term by term, including its lobe-selection probability.
 
 mod conductor;
 mod dielectric;

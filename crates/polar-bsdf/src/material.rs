@@ -1,7 +1,7 @@
 //! Materials as written in the scene file (serde-friendly parameter structs) and
 //! their validation; a material turns into a [`Bsdf`] at a hit point.
 //!
-//! TOML examples (the scene parser owns the `type` tag):
+//! TOML examples (a material is a table whose `type` key picks the variant):
 //! ```toml
 //! type = "conductor"
 //! metal = "au"                 # or: n = 0.2, k = 3.0

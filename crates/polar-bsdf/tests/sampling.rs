@@ -215,3 +215,24 @@ fn chi_square_rough_plastic() {
 fn chi_square_smooth_plastic() {
     chi_square("smooth_plastic");
 }
+
+#[test]
+fn anisotropic_roughness_spreads_along_the_tangent() {
+    // alpha_x = 0.5 along the tangent x, alpha_y = 0.05: seen from the normal,
+    // the mirror lobe is wide in x and narrow in y.
+    let bsdf = Bsdf::Conductor(polar_bsdf::Conductor {
+        eta: gold(),
+        roughness: Some(polar_bsdf::microfacet::Ggx::new(0.5, 0.05)),
+    });
+    let mut rng = rng(9);
+    let (mut xx, mut yy) = (0.0, 0.0);
+    for _ in 0..5000 {
+        let Some(s) = bsdf.sample(&V3::z(), u3(&mut rng)) else {
+            continue;
+        };
+        xx += s.wi.x * s.wi.x;
+        yy += s.wi.y * s.wi.y;
+    }
+    // The slope variances scale as alpha²: a ratio of 100; 10 leaves a wide margin.
+    assert!(xx > 10.0 * yy, "spread x {xx} vs y {yy}");
+}
