@@ -37,7 +37,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 AU = {"eta": 0.43, "k": 2.455}  # polar-bsdf's Metal::Au (Johnson & Christy, 548.6 nm)
 
 CASES = [
-    # name, Mitsuba dict, polar-bsdf TOML, mode ("eval" or ("sample", u0)), two-sided
+    # name, Mitsuba dict, polar-bsdf TOML, mode ("eval" or ("sample", u0)), sides of wo
     ("rough_conductor_iso",
      {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2, **AU},
      "type = 'conductor'\nmetal = 'au'\nroughness = 0.2", "eval", False),
@@ -54,11 +54,23 @@ CASES = [
      "type = 'dielectric'\nior = 1.5", ("sample", 0.0), True),
     ("smooth_dielectric_transmission", {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0},
      "type = 'dielectric'\nior = 1.5", ("sample", 0.9999), True),
+    # Thin sheets agree at normal incidence only ("normal": wo = +-z): Mitsuba's
+    # polarizer angle turns the other way (ours at +30 deg is its theta = -30),
+    # its retarder the same way; off normal, Mitsuba measures the angle from the
+    # unprojected tangent and scales the retardance by |cos theta|, while
+    # polar-bsdf projects the axis onto the wavefront and keeps the retardance.
+    ("polarizer_30deg_normal", {"type": "polarizer", "theta": -30.0},
+     "type = 'polarizer'\nangle_deg = 30.0", ("sample", 0.5), "normal"),
+    ("quarter_wave_30deg_normal", {"type": "retarder", "theta": 30.0, "delta": 90.0},
+     "type = 'retarder'\nangle_deg = 30.0\nretardance_deg = 90.0", ("sample", 0.5), "normal"),
 ]
 
 
 def random_dirs(rng, n, two_sided):
-    """Unit vectors with |cos theta| in [0.05, 1] (upper hemisphere unless two-sided)."""
+    """Unit vectors with |cos theta| in [0.05, 1] (upper hemisphere unless
+    two-sided); exactly +-z when two_sided is "normal"."""
+    if two_sided == "normal":
+        return np.stack([np.zeros(n), np.zeros(n), rng.choice([-1.0, 1.0], n)], axis=1)
     z = rng.uniform(0.05, 1.0, n)
     if two_sided:
         z *= rng.choice([-1.0, 1.0], n)
