@@ -34,8 +34,12 @@ pub fn aolp_hsv(aolp: &Gray<f32>, dolp: &Gray<f32>) -> Rgb8 {
 }
 
 /// OpenCV's 8-bit `HSV2RGB`: hue in `0..180` (2° steps), saturation and value in `0..=255`.
+///
+/// Reproduces OpenCV 5.0 exactly (checked over every hue and value at full
+/// saturation): f32 arithmetic with `x · (1/255)` scaling, `h · (6/180)` sectors and
+/// truncation (not rounding) of the final `· 255`.
 pub fn hsv_to_rgb(h: u8, s: u8, v: u8) -> [u8; 3] {
-    let (s, v) = (f32::from(s) / 255.0, f32::from(v) / 255.0);
+    let (s, v) = (f32::from(s) * (1.0 / 255.0), f32::from(v) * (1.0 / 255.0));
     let h = (f32::from(h) * (6.0 / 180.0)).rem_euclid(6.0);
     let sector = h.floor();
     let f = h - sector;
@@ -54,7 +58,7 @@ pub fn hsv_to_rgb(h: u8, s: u8, v: u8) -> [u8; 3] {
         [3, 1, 0],
         [0, 1, 2],
     ];
-    SECTORS[sector as usize % 6].map(|i| (tab[i] * 255.0).round().clamp(0.0, 255.0) as u8)
+    SECTORS[sector as usize % 6].map(|i| (tab[i] * 255.0) as u8)
 }
 
 /// Anchor colours of the map at `t = 0, 1/8, …, 1` (sampled from matplotlib's viridis), linearly interpolated.

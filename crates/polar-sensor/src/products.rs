@@ -73,6 +73,22 @@ impl StokesPlanes {
         out
     }
 
+    /// DoLP and AoLP of an existing linear Stokes image (e.g. read from `stokes.exr`).
+    pub fn from_linear_stokes(stokes: &LinearStokesImage) -> Self {
+        let (w, h) = stokes.size();
+        let mut out = Self::new(w, h);
+        let src = stokes.pixels();
+        out.rows_mut()
+            .enumerate()
+            .for_each(|(y, [s0, s1, s2, d, a])| {
+                for x in 0..w {
+                    [s0[x], s1[x], s2[x]] = src[y * w + x];
+                }
+                derived_row(s0, s1, s2, d, a);
+            });
+        out
+    }
+
     /// The five planes as parallel iterators over rows `[s0, s1, s2, dolp, aolp]`.
     fn rows_mut(&mut self) -> impl IndexedParallelIterator<Item = [&mut [f32]; 5]> {
         let w = self.s0.width().max(1);

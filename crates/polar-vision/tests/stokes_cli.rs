@@ -1,0 +1,272 @@
+//! End-to-end tests of `polar-vision stokes`: the real binary in a temporary directory.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use polar_image::Gray;
+use polar_sensor::{DemosaicMethod, stokes_planes};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_polar-vision"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Runs `stokes` and asserts failure with a message containing `needle`.
+fn fails_with(args: &[&str], needle: &str) {
+    let out = run(args);
+    assert!(!out.status.success(), "expected failure for {args:?}");
+    assert!(
+        stderr(&out).contains(needle),
+        "stderr for {args:?} lacks {needle:?}:\n{}",
+        stderr(&out)
+    );
+}
+
+fn mosaic8(w: usize, h: usize) -> Gray<u8> {
+    Gray::from_vec(
+        w,
+        h,
+        (0..w * h)
+            .map(|i| (20 + (i * 37 + i / w * 11) % 200) as u8)
+            .collect(),
+    )
+    .unwrap()
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+const OUTPUTS: [&str; 7] = [
+    "stokes.exr",
+    "dolp.exr",
+    "aolp.exr",
+    "aolp.png",
+    "dolp.png",
+    "s0.png",
+    "mask.png",
+];
+
+#[test]
+fn writes_every_output_and_matches_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let raw = mosaic8(16, 12);
+    let input = dir.path().join("raw.png");
+    polar_io::write_gray8_png(&input, &raw).unwrap();
+    let out_dir = dir.path().join("out");
+    for method in DemosaicMethod::ALL {
+        let out = run(&[
+            "stokes",
+            p(&input),
+            "--out",
+            p(&out_dir),
+            "--demosaic",
+            method.name(),
+        ]);
+        assert!(out.status.success(), "{method}: {}", stderr(&out));
+        for f in OUTPUTS {
+            assert!(out_dir.join(f).is_file(), "{method}: missing {f}");
+        }
+        let want = stokes_planes(&raw, method).unwrap();
+        let got = polar_io::read_exr(out_dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS)
+            .unwrap();
+        assert_eq!(got, want.linear_stokes(), "{method}");
+        let dolp = polar_io::read_exr_channel(out_dir.join("dolp.exr"), "Y").unwrap();
+        assert_eq!(dolp.size(), want.dolp.size());
+    }
+}
+
+#[test]
+fn sample_directory_with_raw_png_or_only_stokes_exr() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = dir.path().join("sample");
+    std::fs::create_dir(&sample).unwrap();
+    polar_io::write_gray8_png(sample.join("raw.png"), &mosaic8(8, 8)).unwrap();
+    let out1 = dir.path().join("o1");
+    assert!(
+        run(&["stokes", p(&sample), "--out", p(&out1)])
+            .status
+            .success()
+    );
+
+    // Only stokes.exr: DoLP/AoLP from it directly.
+    std::fs::remove_file(sample.join("raw.png")).unwrap();
+    std::fs::copy(out1.join("stokes.exr"), sample.join("stokes.exr")).unwrap();
+    let out2 = dir.path().join("o2");
+    let out = run(&["stokes", p(&sample), "--out", p(&out2)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        polar_io::read_exr_channel(out1.join("dolp.exr"), "Y").unwrap(),
+        polar_io::read_exr_channel(out2.join("dolp.exr"), "Y").unwrap()
+    );
+
+    std::fs::remove_file(sample.join("stokes.exr")).unwrap();
+    fails_with(
+        &["stokes", p(&sample), "--out", p(&out2)],
+        "not a PNG file nor a sample directory",
+    );
+}
+
+#[test]
+fn odd_tiny_zero_and_saturated_frames_are_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let case = |name: &str, img: Gray<u8>| -> PathBuf {
+        let path = dir.path().join(name);
+        polar_io::write_gray8_png(&path, &img).unwrap();
+        path
+    };
+    let odd = case("odd.png", mosaic8(15, 12));
+    fails_with(&["stokes", p(&odd), "--out", p(&out)], "must be even");
+    let tiny = case("tiny.png", mosaic8(1, 1));
+    fails_with(&["stokes", p(&tiny), "--out", p(&out)], "1x1");
+    let zero = case("zero.png", Gray::new(8, 8));
+    fails_with(&["stokes", p(&zero), "--out", p(&out)], "every pixel is 0");
+    let sat = case("sat.png", Gray::from_vec(8, 8, vec![255; 64]).unwrap());
+    fails_with(
+        &["stokes", p(&sat), "--out", p(&out)],
+        "every pixel is saturated",
+    );
+
+    // Partly saturated: works, warns, and flags the mask.
+    let mut part = mosaic8(8, 8);
+    part.as_mut_slice()[0] = 255;
+    let part = case("part.png", part);
+    let res = run(&["stokes", p(&part), "--out", p(&out)]);
+    assert!(res.status.success());
+    assert!(stderr(&res).contains("1 of 64 pixels"), "{}", stderr(&res));
+    let mask = polar_io::read_gray8_png(out.join("mask.png")).unwrap();
+    assert_eq!(mask.pixel(0, 0)[0], polar_sensor::mask::SATURATED);
+    assert_eq!(mask.pixel(7, 7)[0], 0);
+}
+
+#[test]
+fn twelve_bit_data_left_or_right_aligned_in_16_bit_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let right: Gray<u16> = Gray::from_vec(
+        8,
+        8,
+        (0..64).map(|i| (100 + i * 61 % 3900) as u16).collect(),
+    )
+    .unwrap();
+    let left = Gray::from_vec(8, 8, right.as_slice().iter().map(|v| v << 4).collect()).unwrap();
+    let (rp, lp) = (dir.path().join("right.png"), dir.path().join("left.png"));
+    polar_io::write_gray16_png(&rp, &right).unwrap();
+    polar_io::write_gray16_png(&lp, &left).unwrap();
+    let (o1, o2) = (dir.path().join("o1"), dir.path().join("o2"));
+    let ok = run(&[
+        "stokes",
+        p(&rp),
+        "--out",
+        p(&o1),
+        "--bit-depth",
+        "12",
+        "--align",
+        "right",
+    ]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let ok = run(&[
+        "stokes",
+        p(&lp),
+        "--out",
+        p(&o2),
+        "--bit-depth",
+        "12",
+        "--align",
+        "left",
+    ]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let s = |o: &Path| polar_io::read_exr_channel(o.join("stokes.exr"), "S0").unwrap();
+    assert_eq!(s(&o1), s(&o2), "both alignments give the same DN");
+
+    fails_with(
+        &["stokes", p(&lp), "--out", p(&o1), "--bit-depth", "12"],
+        "try --align left",
+    );
+    fails_with(
+        &[
+            "stokes",
+            p(&rp),
+            "--out",
+            p(&o1),
+            "--bit-depth",
+            "12",
+            "--align",
+            "left",
+        ],
+        "try --align right",
+    );
+    let eight = dir.path().join("eight.png");
+    polar_io::write_gray8_png(&eight, &mosaic8(8, 8)).unwrap();
+    fails_with(
+        &["stokes", p(&eight), "--out", p(&o1), "--bit-depth", "12"],
+        "more than the 8-bit samples",
+    );
+    fails_with(
+        &["stokes", p(&eight), "--out", p(&o1), "--bit-depth", "11"],
+        "invalid value '11'",
+    );
+}
+
+#[test]
+fn truncated_non_png_missing_input_and_bad_arguments() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let good = dir.path().join("good.png");
+    polar_io::write_gray8_png(&good, &mosaic8(64, 64)).unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    let truncated = dir.path().join("truncated.png");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    fails_with(
+        &["stokes", p(&truncated), "--out", p(&out)],
+        "truncated or corrupt",
+    );
+    let text = dir.path().join("notes.png");
+    std::fs::write(&text, "not an image").unwrap();
+    fails_with(
+        &["stokes", p(&text), "--out", p(&out)],
+        "truncated or corrupt",
+    );
+    fails_with(
+        &[
+            "stokes",
+            p(&dir.path().join("missing.png")),
+            "--out",
+            p(&out),
+        ],
+        "no such file",
+    );
+    fails_with(
+        &["stokes", p(&good), "--out", p(&out), "--demosaic", "cubic"],
+        "unknown demosaicing method `cubic`",
+    );
+    fails_with(&["stokes", p(&good)], "--out");
+    // --out naming a file is rejected before any work.
+    fails_with(&["stokes", p(&good), "--out", p(&good)], "not a directory");
+}
+
+#[test]
+fn help_explains_every_option() {
+    let out = run(&["stokes", "--help"]);
+    assert!(out.status.success());
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needle in [
+        "--out",
+        "--demosaic",
+        "superpixel",
+        "bilinear",
+        "newton",
+        "--bit-depth",
+        "--align",
+        "aolp.png",
+        "mask.png",
+    ] {
+        assert!(help.contains(needle), "help lacks {needle}:\n{help}");
+    }
+}
