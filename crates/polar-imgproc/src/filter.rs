@@ -131,7 +131,8 @@ pub fn sep_filter(
 /// `out = sum_i k[i] tap(i)` over equal-length slices, tap-major so the inner loops
 /// vectorise. Symmetric kernels (Gaussian, smoothers) and antisymmetric ones (first
 /// derivatives) fold pairs of taps first, halving the multiplications.
-fn correlate<'a>(k: &[f32], tap: impl Fn(usize) -> &'a [f32], out: &mut [f32]) {
+#[inline(always)]
+pub(crate) fn correlate<'a>(k: &[f32], tap: impl Fn(usize) -> &'a [f32], out: &mut [f32]) {
     let n = k.len();
     let r = n / 2;
     let symmetric = (0..r).all(|i| k[i] == k[n - 1 - i]);
@@ -224,6 +225,7 @@ pub fn box_filter(
 /// Sums of `kw` consecutive values of `pad` in `f64`: `out[x] = sum(pad[x .. x + kw])`.
 /// Short windows add the taps directly (vectorised); long ones keep running sums in four
 /// interleaved segments so that the add/subtract chains overlap in the pipeline.
+#[inline(always)]
 fn row_box_sum(pad: &[f32], kw: usize, out: &mut [f64]) {
     let w = out.len();
     if kw <= 9 {

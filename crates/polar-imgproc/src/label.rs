@@ -230,21 +230,30 @@ pub fn component_stats(labels: &Gray<u32>, n: usize) -> Result<Vec<ComponentStat
         .enumerate()
         .map(|(k, rows)| {
             let mut acc = vec![EMPTY; n + 1];
-            for (i, &l) in rows.iter().enumerate() {
-                let a = acc.get_mut(l as usize).ok_or(Error::ClassOutOfRange {
-                    value: l,
-                    n_classes: n + 1,
-                })?;
-                let (x, y) = (i % w, k * STRIPE_ROWS + i / w);
-                *a = a.merge(Acc {
-                    x0: x,
-                    y0: y,
-                    x1: x,
-                    y1: y,
-                    area: 1,
-                    sx: x as u64,
-                    sy: y as u64,
-                });
+            // Runs of equal labels along each row: one update per run, not per pixel.
+            for (r, row) in rows.chunks_exact(w).enumerate() {
+                let y = k * STRIPE_ROWS + r;
+                let mut x0 = 0;
+                while x0 < w {
+                    let l = row[x0];
+                    let len = row[x0..].iter().position(|&v| v != l).unwrap_or(w - x0);
+                    let x1 = x0 + len - 1;
+                    let a = acc.get_mut(l as usize).ok_or(Error::ClassOutOfRange {
+                        value: l,
+                        n_classes: n + 1,
+                    })?;
+                    let run = Acc {
+                        x0,
+                        y0: y,
+                        x1,
+                        y1: y,
+                        area: len as u64,
+                        sx: ((x0 + x1) * len / 2) as u64,
+                        sy: (y * len) as u64,
+                    };
+                    *a = a.merge(run);
+                    x0 = x1 + 1;
+                }
             }
             Ok(acc)
         })

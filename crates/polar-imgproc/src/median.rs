@@ -115,15 +115,18 @@ impl Lane for u8 {}
 /// Pixels per network evaluation (all slots stay in L1).
 const CHUNK: usize = 128;
 
+#[inline(always)]
 fn lo<T: Lane>(a: T, b: T) -> T {
     if b < a { b } else { a }
 }
 
+#[inline(always)]
 fn hi<T: Lane>(a: T, b: T) -> T {
     if b < a { a } else { b }
 }
 
 /// Two distinct slots of length `len` of a flat buffer, mutably.
+#[inline(always)]
 fn two_slots<T>(buf: &mut [T], len: usize, a: usize, b: usize) -> (&mut [T], &mut [T]) {
     if a < b {
         let (x, y) = buf.split_at_mut(b * len);
@@ -135,6 +138,7 @@ fn two_slots<T>(buf: &mut [T], len: usize, a: usize, b: usize) -> (&mut [T], &mu
 }
 
 /// Runs the network over slots of length `len` stored back to back in `buf`.
+#[inline(always)]
 fn apply<T: Lane>(steps: &[Step], buf: &mut [T], len: usize) {
     for &s in steps {
         match s {
@@ -235,6 +239,7 @@ fn median_small<T: Lane>(src: &Gray<T>, dst: &mut Gray<T>, ksize: usize) {
 /// 3x3 median from sorted columns (`lo <= mid <= hi` per column):
 /// `med3(max(lo), med3(mid), min(hi))` over three neighbouring columns, a classic
 /// identity (e.g. Paeth, Graphics Gems 1990) that needs no copies.
+#[inline(always)]
 fn median3_of_sorted_columns<T: Lane>(cols: &[T], pw: usize, order: &[usize], out: &mut [T]) {
     let w = out.len();
     let row = |rank: usize, dx: usize| &cols[order[rank] * pw + dx..order[rank] * pw + dx + w];

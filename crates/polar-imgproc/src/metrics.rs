@@ -96,11 +96,12 @@ fn ssim_impl(
     let c2 = ((0.03 * data_range).powi(2)) as f32;
     let (sa, sb) = (a.as_slice(), b.as_slice());
     let r = SSIM_RADIUS;
-    let band = |y0: usize, out: Option<&mut [f32]>, n_out: usize| -> f64 {
+    type Scratch = (Vec<f32>, Vec<f32>, Vec<f32>);
+    let band = |sc: &mut Scratch, y0: usize, out: Option<&mut [f32]>, n_out: usize| -> f64 {
         // Horizontal pass of x, y, xx, yy, xy for rows y0 - r .. y0 + n_out + r.
         let n_tmp = n_out + 2 * r;
-        let mut tmp = vec![0.0f32; 5 * n_tmp * w];
-        let mut pads = vec![0.0f32; 5 * (w + 2 * r)];
+        let tmp = crate::scratch(&mut sc.0, 5 * n_tmp * w, 0.0);
+        let pads = crate::scratch(&mut sc.1, 5 * (w + 2 * r), 0.0);
         let pw = w + 2 * r;
         for t in 0..n_tmp {
             let y = Border::Reflect.index((y0 + t) as isize - r as isize, h);
@@ -119,25 +120,21 @@ fn ssim_impl(
             for q in 0..5 {
                 let dst = &mut tmp[(q * n_tmp + t) * w..(q * n_tmp + t + 1) * w];
                 let src = &pads[q * pw..(q + 1) * pw];
-                dst.fill(0.0);
-                for (i, &ki) in k.iter().enumerate() {
-                    dst.iter_mut()
-                        .zip(&src[i..i + w])
-                        .for_each(|(o, v)| *o += ki * v);
-                }
+                crate::filter::correlate(&k, |i| &src[i..i + w], dst);
             }
         }
-        let mut mu = vec![0.0f32; 5 * w];
+        let mu = crate::scratch(&mut sc.2, 5 * w, 0.0);
         let mut out = out;
         let mut sum = 0.0f64;
         for row in 0..n_out {
             for q in 0..5 {
                 let m = &mut mu[q * w..(q + 1) * w];
-                m.fill(0.0);
-                for (j, &kj) in k.iter().enumerate() {
-                    let t = &tmp[(q * n_tmp + row + j) * w..(q * n_tmp + row + j + 1) * w];
-                    m.iter_mut().zip(t).for_each(|(o, v)| *o += kj * v);
-                }
+                let tmp: &[f32] = tmp;
+                crate::filter::correlate(
+                    &k,
+                    |j| &tmp[(q * n_tmp + row + j) * w..(q * n_tmp + row + j + 1) * w],
+                    m,
+                );
             }
             let (ux, rest) = mu.split_at(w);
             let (uy, rest) = rest.split_at(w);
@@ -173,14 +170,16 @@ fn ssim_impl(
             .as_mut_slice()
             .par_chunks_mut(w * BAND_ROWS)
             .enumerate()
-            .map(|(i, o)| {
+            .map_init(Scratch::default, |sc, (i, o)| {
                 let n = o.len() / w;
-                band(i * BAND_ROWS, Some(o), n)
+                band(sc, i * BAND_ROWS, Some(o), n)
             })
             .sum(),
         None => (0..h.div_ceil(BAND_ROWS))
             .into_par_iter()
-            .map(|i| band(i * BAND_ROWS, None, BAND_ROWS.min(h - i * BAND_ROWS)))
+            .map_init(Scratch::default, |sc, i| {
+                band(sc, i * BAND_ROWS, None, BAND_ROWS.min(h - i * BAND_ROWS))
+            })
             .sum(),
     };
     Ok(total / ((w - 2 * r) * (h - 2 * r)) as f64)

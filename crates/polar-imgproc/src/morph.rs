@@ -72,6 +72,7 @@ struct Max;
 
 impl Pick for Min {
     const NEUTRAL: f32 = f32::INFINITY;
+    #[inline(always)]
     fn pick(a: f32, b: f32) -> f32 {
         if b < a { b } else { a }
     }
@@ -79,6 +80,7 @@ impl Pick for Min {
 
 impl Pick for Max {
     const NEUTRAL: f32 = f32::NEG_INFINITY;
+    #[inline(always)]
     fn pick(a: f32, b: f32) -> f32 {
         if b > a { b } else { a }
     }
@@ -194,6 +196,7 @@ fn prev_pow2(n: usize) -> usize {
 
 /// Vertical extremum over `kh` consecutive rows of `tmp` (`n_tmp` rows of width `w`) into
 /// `out`, by in-place doubling as for the rows.
+#[inline(always)]
 fn vertical_doubling<P: Pick>(tmp: &mut [f32], w: usize, n_tmp: usize, kh: usize, out: &mut [f32]) {
     let p = prev_pow2(kh);
     let mut span = 1;
