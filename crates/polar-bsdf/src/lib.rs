@@ -83,7 +83,7 @@ pub struct BsdfSample {
 }
 
 /// A polarized BSDF at one surface point (a closed set, one `match` per method).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bsdf {
     /// Ideal depolarizing Lambertian reflector.
     Lambertian(Lambertian),
