@@ -102,7 +102,8 @@ def morphology(wr, img):
            "close": cv2.MORPH_CLOSE}
     for op, shape, kw, kh in [("erode", "rect", 3, 3), ("dilate", "rect", 5, 3), ("erode", "ellipse", 5, 5),
                               ("dilate", "cross", 3, 3), ("open", "rect", 5, 5), ("close", "ellipse", 7, 7),
-                              ("erode", "ellipse", 9, 7), ("dilate", "cross", 5, 7), ("dilate", "rect", 4, 6)]:
+                              ("erode", "ellipse", 9, 7), ("dilate", "cross", 5, 7), ("dilate", "rect", 4, 6),
+                              ("dilate", "rect", 15, 11), ("erode", "rect", 3, 12)]:
         kernel = cv2.getStructuringElement(shapes[shape], (kw, kh))
         out = cv2.morphologyEx(img, ops[op], kernel)
         wr.case(f"{op}_{shape}_{kw}x{kh}", op, {"shape": shape, "kw": kw, "kh": kh}, {"src": ("img", img)},

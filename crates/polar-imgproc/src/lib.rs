@@ -1,12 +1,25 @@
 //! Classic image-processing primitives for the analysis crates, each validated
 //! against the implementation users trust (OpenCV 5 / opencv-contrib, scikit-image 0.26)
-//! by golden files written by `tools/imgproc_goldens.py`.
+//! by golden files written by `tools/imgproc_goldens.py` and replayed in `tests/golden.rs`.
 //!
 //! Conventions (as in kornia-rs): an operation takes `(&src, &mut dst)` and returns
-//! `Result<(), Error>`; the caller allocates `dst` with the right size; nothing here does
-//! I/O. Images are [`Gray<f32>`](polar_image::Gray) (and `Gray<u8>` for masks, `Gray<u32>`
-//! for label maps). Every function states which OpenCV border mode it reproduces.
-//! Work is split over rows with rayon.
+//! `Result<_, Error>`; the caller allocates `dst` with the right size; nothing here does
+//! I/O. Images are [`Gray<f32>`](polar_image::Gray) (`Gray<u8>` for masks and class maps,
+//! `Gray<u32>` for label maps). Work is split over row bands with rayon.
+//!
+//! | function | matches | border |
+//! |---|---|---|
+//! | [`gaussian_blur`] | `cv2.GaussianBlur(src, (k, k), sigma)` | `BORDER_REFLECT_101` |
+//! | [`box_filter`] | `cv2.boxFilter(src, -1, (kw, kh), normalize=True)` | chosen, default `REFLECT_101` |
+//! | [`sobel`], [`scharr`] | `cv2.Sobel(src, CV_32F, dx, dy, k)`, `cv2.Scharr` | `BORDER_REFLECT_101` |
+//! | [`sep_filter`] | `cv2.sepFilter2D(src, CV_32F, kx, ky)` | chosen |
+//! | [`erode`], [`dilate`], [`open`], [`close`], [`min_filter`], [`max_filter`] | `cv2.erode`/`dilate`/`morphologyEx` with `getStructuringElement` | outside pixels ignored (OpenCV's default constant border) |
+//! | [`median_blur`], [`median_blur_u8`] | `cv2.medianBlur` | `BORDER_REPLICATE` |
+//! | [`guided_filter`] | `cv2.ximgproc.guidedFilter(guide, src, r, eps)` | `BORDER_REFLECT` (its box means) |
+//! | [`threshold_otsu`], [`threshold_otsu_u8`] | `skimage.filters.threshold_otsu` | - |
+//! | [`label`], [`component_stats`] | `skimage.measure.label`, `cv2.connectedComponentsWithStats` | - |
+//! | [`psnr`], [`ssim`], [`ssim_map`] | `skimage.metrics.peak_signal_noise_ratio`, `structural_similarity` | SSIM: `BORDER_REFLECT` (scipy `reflect`) |
+//! | [`angular_error`], [`iou`], [`ConfusionMatrix`] | numpy formulas in the golden script | - |
 
 mod border;
 mod filter;

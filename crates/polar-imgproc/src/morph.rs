@@ -143,8 +143,19 @@ fn morph<P: Pick>(
                     }
                     continue;
                 };
-                cur.fill(neutral);
+                cur[..ax].fill(neutral);
+                cur[ax + w..].fill(neutral);
                 cur[ax..ax + w].copy_from_slice(&s[y * w..(y + 1) * w]);
+                if distinct.len() == 1 && max_len <= DIRECT_MAX {
+                    for (d, &(x0, len)) in distinct.iter().enumerate() {
+                        let taps: Vec<&[f32]> = (x0..x0 + len).map(|i| &cur[i..i + w]).collect();
+                        pick_into::<P>(
+                            &mut tmp[(d * n_tmp + t) * w..(d * n_tmp + t + 1) * w],
+                            &taps,
+                        );
+                    }
+                    continue;
+                }
                 // Doubling: at level `span`, cur[x] = extremum of the `span` pixels from x; a
                 // run of length len is two overlapping windows of the largest span <= len.
                 let mut span = 1;
@@ -171,22 +182,60 @@ fn morph<P: Pick>(
                     span *= 2;
                 }
             }
-            if rect {
+            if rect && kh > DIRECT_MAX {
                 vertical_doubling::<P>(tmp, w, n_tmp, kh, out);
                 return;
             }
+            let tmp: &[f32] = tmp;
             for (r, orow) in out.chunks_exact_mut(w).enumerate() {
-                orow.fill(neutral);
-                for &(dy, d) in &rows_of {
-                    let t = &tmp[(d * n_tmp + r + dy) * w..(d * n_tmp + r + dy + 1) * w];
-                    orow.iter_mut()
-                        .zip(t)
-                        .for_each(|(a, &v)| *a = P::pick(*a, v));
-                }
+                let taps: Vec<&[f32]> = rows_of
+                    .iter()
+                    .map(|&(dy, d)| &tmp[(d * n_tmp + r + dy) * w..(d * n_tmp + r + dy + 1) * w])
+                    .collect();
+                pick_into::<P>(orow, &taps);
             }
         },
     );
     Ok(())
+}
+
+/// A rectangle's rows (one run) up to this length, and its columns up to this height, are
+/// reduced tap by tap (fused four at a time); longer runs, and shapes with several run
+/// lengths (cross, ellipse, which share the doubling levels), use doubling, whose cost
+/// is logarithmic in the length.
+const DIRECT_MAX: usize = 8;
+
+/// `out[x] = extremum of tap[x] over all taps` (at least one), reading up to four taps
+/// per pass over `out` to keep memory traffic low.
+fn pick_into<P: Pick>(out: &mut [f32], taps: &[&[f32]]) {
+    let (first, rest) = taps.split_at(taps.len().min(4));
+    let o = out.iter_mut();
+    match first {
+        [a] => o.zip(*a).for_each(|(o, &a)| *o = a),
+        [a, b] => o
+            .zip(a.iter().zip(*b))
+            .for_each(|(o, (&a, &b))| *o = P::pick(a, b)),
+        [a, b, c] => o
+            .zip(a.iter().zip(b.iter().zip(*c)))
+            .for_each(|(o, (&a, (&b, &c)))| *o = P::pick(P::pick(a, b), c)),
+        [a, b, c, d] => o
+            .zip(a.iter().zip(b.iter().zip(c.iter().zip(*d))))
+            .for_each(|(o, (&a, (&b, (&c, &d))))| *o = P::pick(P::pick(a, b), P::pick(c, d))),
+        _ => {}
+    }
+    for g in rest.chunks(3) {
+        let o = out.iter_mut();
+        match g {
+            [a] => o.zip(*a).for_each(|(o, &a)| *o = P::pick(*o, a)),
+            [a, b] => o
+                .zip(a.iter().zip(*b))
+                .for_each(|(o, (&a, &b))| *o = P::pick(*o, P::pick(a, b))),
+            [a, b, c] => o
+                .zip(a.iter().zip(b.iter().zip(*c)))
+                .for_each(|(o, (&a, (&b, &c)))| *o = P::pick(P::pick(*o, a), P::pick(b, c))),
+            _ => {}
+        }
+    }
 }
 
 /// Largest power of two `<= n` (`n >= 1`).
