@@ -75,20 +75,31 @@ fn label_stripe(src: &[u8], w: usize, out: &mut [u32], conn: Connectivity) -> Fo
             if v == 0 {
                 continue;
             }
-            let mut label = 0;
-            for &(dx, dy) in previous_neighbours(conn) {
+            let at = |dx: isize, dy: isize| -> Option<usize> {
                 let (nx, ny) = (x as isize + dx, y as isize + dy);
-                if nx < 0 || ny < 0 || nx >= w as isize {
-                    continue;
-                }
-                let n = ny as usize * w + nx as usize;
-                if src[n] != v {
-                    continue;
-                }
-                label = if label == 0 {
-                    out[n]
-                } else {
-                    forest.union(label, out[n])
+                (nx >= 0 && ny >= 0 && nx < w as isize).then(|| ny as usize * w + nx as usize)
+            };
+            let same = |n: Option<usize>| n.filter(|&n| src[n] == v);
+            // Only the neighbours that can belong to different provisional sets (the
+            // decision tree of Wu et al.'s SAUF): with 8-connectivity, a matching pixel
+            // above already joined its left/right neighbours, and a matching left pixel
+            // already joined the upper-left one.
+            let candidates = match conn {
+                Connectivity::Four => [same(at(-1, 0)), same(at(0, -1))],
+                Connectivity::Eight => match same(at(0, -1)) {
+                    Some(up) => [Some(up), None],
+                    None => [
+                        same(at(-1, 0)).or_else(|| same(at(-1, -1))),
+                        same(at(1, -1)),
+                    ],
+                },
+            };
+            let mut label = 0;
+            for n in candidates.into_iter().flatten() {
+                label = match label {
+                    0 => out[n],
+                    l if l == out[n] => l,
+                    l => forest.union(l, out[n]),
                 };
             }
             out[y * w + x] = if label == 0 { forest.push() } else { label };
