@@ -9,9 +9,9 @@ use polar_image::Gray;
 use crate::{BAND_ROWS, Border, Error, same_size};
 
 /// Rows per band for a filter of vertical radius `ry`: the halo rows a band recomputes
-/// stay below a third of its work.
+/// stay at or below a fifth of its work.
 pub(crate) fn band_rows(ry: usize) -> usize {
-    BAND_ROWS.max(4 * ry)
+    BAND_ROWS.max(8 * ry)
 }
 
 /// The kernel of `cv::getGaussianKernel(ksize, sigma)` as OpenCV 5 builds it: for
