@@ -160,12 +160,13 @@ fn median_small<T: Lane>(src: &Gray<T>, dst: &mut Gray<T>, ksize: usize) {
             }
             let cols = crate::scratch(sc_cols, ksize * pw, T::default());
             for (row, orow) in out.chunks_exact_mut(w).enumerate() {
-                cols.copy_from_slice(&padded[row * pw..(row + ksize) * pw]);
-                sort_slots(column, cols, pw);
                 if ksize == 3 {
-                    median3_of_sorted_columns(cols, pw, order, orow);
+                    sort3_columns(&padded[row * pw..(row + 3) * pw], cols);
+                    median3_of_sorted_columns(cols, pw, &[0, 1, 2], orow);
                     continue;
                 }
+                cols.copy_from_slice(&padded[row * pw..(row + ksize) * pw]);
+                sort_slots(column, cols, pw);
                 let taps: [&[T]; 25] = std::array::from_fn(|i| {
                     let start = order[i % 5] * pw + i / 5;
                     &cols[start..start + w]
@@ -196,6 +197,22 @@ fn median3_of_sorted_columns<T: Lane>(cols: &[T], pw: usize, order: &[usize], ou
         let b = med3(m0[x], m1[x], m2[x]);
         let c = lo(lo(h0[x], h1[x]), h2[x]);
         out[x] = med3(a, b, c);
+    }
+}
+
+/// Sorts the columns of three consecutive rows (`rows`, three rows back to back) into
+/// `cols` (lowest row, middle row, highest row) in one pass.
+fn sort3_columns<T: Lane>(rows: &[T], cols: &mut [T]) {
+    let pw = rows.len() / 3;
+    let (a, rest) = rows.split_at(pw);
+    let (b, c) = rest.split_at(pw);
+    let (l, rest) = cols.split_at_mut(pw);
+    let (m, h) = rest.split_at_mut(pw);
+    for x in 0..pw {
+        let (p, q) = (lo(a[x], b[x]), hi(a[x], b[x]));
+        l[x] = lo(p, c[x]);
+        m[x] = hi(p, lo(q, c[x]));
+        h[x] = hi(q, c[x]);
     }
 }
 
