@@ -1,0 +1,302 @@
+//! Ray-geometry queries: primitives (triangles, analytic spheres) in a
+//! compressed-wide BVH built once per scene with obvhs (PLOC builder), traversed
+//! for the closest hit and, for shadow rays, for any hit.
+//!
+//! obvhs works in `f32`; the BVH only culls, and every primitive test (and the
+//! final hit) is done in `f64` in the scene's own primitive list, which is
+//! reordered once after the build to obvhs's primitive order.
+
+use crate::scene::{Geometry, Scene, Vec3};
+use glam::Vec3A;
+use obvhs::{
+    Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::Ray,
+    ray::RayHit,
+};
+
+/// One primitive of one shape.
+#[derive(Clone, Debug)]
+pub(crate) enum Primitive {
+    /// Triangle `index` of a mesh shape, with its vertex positions.
+    Triangle {
+        /// Owning shape.
+        shape: u32,
+        /// Triangle index within the mesh.
+        index: u32,
+        /// Vertex positions.
+        p: [Vec3; 3],
+    },
+    /// An analytic sphere shape.
+    Sphere {
+        /// Owning shape.
+        shape: u32,
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f64,
+    },
+}
+
+/// A surface point found by a ray.
+#[derive(Clone, Debug)]
+pub(crate) struct SurfaceHit {
+    /// Position.
+    pub p: Vec3,
+    /// Geometric normal on the front side (winding order / outward).
+    pub ng: Vec3,
+    /// Shading normal (interpolated or exact), in the same hemisphere as `ng`.
+    pub ns: Vec3,
+    /// Texture coordinates.
+    pub uv: [f64; 2],
+    /// Index of the shape hit.
+    pub shape: usize,
+}
+
+impl Boundable for Primitive {
+    fn aabb(&self) -> Aabb {
+        let (lo, hi) = match self {
+            Primitive::Triangle { p, .. } => {
+                (p[0].inf(&p[1]).inf(&p[2]), p[0].sup(&p[1]).sup(&p[2]))
+            }
+            Primitive::Sphere { center, radius, .. } => {
+                (center.add_scalar(-radius), center.add_scalar(*radius))
+            }
+        };
+        // Pad outward so that rounding to f32 never shrinks the box.
+        let pad = |v: Vec3, s: f64| {
+            let c = v.map(|c| (c + s * 1e-6 * (1.0 + c.abs())) as f32);
+            Vec3A::new(c.x, c.y, c.z)
+        };
+        Aabb::new(pad(lo, -1.0), pad(hi, 1.0))
+    }
+}
+
+impl Primitive {
+    /// Shape index.
+    pub fn shape(&self) -> usize {
+        match self {
+            Primitive::Triangle { shape, .. } | Primitive::Sphere { shape, .. } => *shape as usize,
+        }
+    }
+
+    /// Surface area.
+    pub fn area(&self) -> f64 {
+        match self {
+            Primitive::Triangle { p, .. } => 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm(),
+            Primitive::Sphere { radius, .. } => 4.0 * std::f64::consts::PI * radius * radius,
+        }
+    }
+
+    /// Nearest intersection in `(tmin, tmax)` as `(t, b1, b2)` (barycentrics for triangles).
+    pub fn intersect(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<(f64, f64, f64)> {
+        match self {
+            Primitive::Triangle { p, .. } => {
+                // Möller–Trumbore (1997).
+                let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+                let pv = d.cross(&e2);
+                let det = e1.dot(&pv);
+                if det == 0.0 || !det.is_finite() {
+                    return None;
+                }
+                let inv = 1.0 / det;
+                let s = o - p[0];
+                let b1 = s.dot(&pv) * inv;
+                let q = s.cross(&e1);
+                let b2 = d.dot(&q) * inv;
+                let t = e2.dot(&q) * inv;
+                (b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 && t > tmin && t < tmax)
+                    .then_some((t, b1, b2))
+            }
+            Primitive::Sphere { center, radius, .. } => {
+                // Stable quadratic for |d| = 1: t = -b ± sqrt(r² - |f - b d|²) with f = o - c, b = f·d.
+                let f = o - center;
+                let b = f.dot(d);
+                let disc = radius * radius - (f - b * d).norm_squared();
+                if disc < 0.0 {
+                    return None;
+                }
+                let root = disc.sqrt();
+                let c = f.norm_squared() - radius * radius;
+                let q = -b - root.copysign(b);
+                let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q) };
+                let (t0, t1) = (t0.min(t1), t0.max(t1));
+                [t0, t1]
+                    .into_iter()
+                    .find(|t| *t > tmin && *t < tmax)
+                    .map(|t| (t, 0.0, 0.0))
+            }
+        }
+    }
+
+    /// Uniformly samples a point on the surface: `(position, front normal)`.
+    pub fn sample_point(&self, u: [f64; 2]) -> (Vec3, Vec3) {
+        match self {
+            Primitive::Triangle { p, .. } => {
+                let s = u[0].sqrt();
+                let (b1, b2) = (s * (1.0 - u[1]), s * u[1]);
+                let pos = p[0] * (1.0 - b1 - b2) + p[1] * b1 + p[2] * b2;
+                (pos, (p[1] - p[0]).cross(&(p[2] - p[0])).normalize())
+            }
+            Primitive::Sphere { center, radius, .. } => {
+                let z = 1.0 - 2.0 * u[0];
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = std::f64::consts::TAU * u[1];
+                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                (center + *radius * n, n)
+            }
+        }
+    }
+}
+
+/// A ray's closest primitive: its index, distance and barycentric coordinates.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrimHit {
+    pub prim: usize,
+    pub t: f64,
+    pub b1: f64,
+    pub b2: f64,
+}
+
+/// The scene's primitives and their BVH.
+pub(crate) struct Accel {
+    bvh: Option<CwBvh>,
+    /// Primitives in obvhs's order (index = obvhs primitive id).
+    pub prims: Vec<Primitive>,
+}
+
+/// Self-intersection guard for rays leaving a surface, relative to the scene scale.
+pub(crate) const RAY_EPSILON: f64 = 1e-7;
+
+impl Accel {
+    /// Collects the primitives of `scene` and builds the BVH (medium-quality PLOC preset).
+    pub fn build(scene: &Scene) -> Self {
+        let mut prims = Vec::new();
+        for (s, shape) in scene.shapes.iter().enumerate() {
+            let shape_id = s as u32;
+            match &shape.geometry {
+                Geometry::Sphere { center, radius } => prims.push(Primitive::Sphere {
+                    shape: shape_id,
+                    center: *center,
+                    radius: *radius,
+                }),
+                Geometry::Mesh(m) => {
+                    prims.extend(
+                        m.triangles
+                            .iter()
+                            .enumerate()
+                            .map(|(i, t)| Primitive::Triangle {
+                                shape: shape_id,
+                                index: i as u32,
+                                p: t.map(|v| m.positions[v as usize]),
+                            }),
+                    )
+                }
+            }
+        }
+        if prims.is_empty() {
+            return Self { bvh: None, prims };
+        }
+        let bvh = build_cwbvh(
+            &prims,
+            BvhBuildParams::medium_build(),
+            &mut Default::default(),
+        );
+        let prims = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| prims[i as usize].clone())
+            .collect();
+        Self {
+            bvh: Some(bvh),
+            prims,
+        }
+    }
+
+    fn f32_ray(o: &Vec3, d: &Vec3, tmax: f64) -> Ray {
+        let v = |v: &Vec3| Vec3A::new(v.x as f32, v.y as f32, v.z as f32);
+        Ray::new(v(o), v(d), 0.0, tmax.min(f64::from(f32::MAX)) as f32)
+    }
+
+    /// Closest primitive hit along the unit direction `d` in `(tmin, tmax)`: `(primitive, t, b1, b2)`.
+    pub fn closest(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
+        let bvh = self.bvh.as_ref()?;
+        let mut hit = RayHit::none();
+        let found = bvh.ray_traverse(Self::f32_ray(o, d, tmax), &mut hit, |ray, id| {
+            let limit = f64::from(ray.tmax).min(tmax);
+            self.prims[id]
+                .intersect(o, d, tmin, limit * (1.0 + 1e-6))
+                .map_or(f32::INFINITY, |h| h.0 as f32)
+        });
+        if !found {
+            return None;
+        }
+        let id = hit.primitive_id as usize;
+        let (t, b1, b2) = self.prims[id].intersect(o, d, tmin, tmax)?;
+        Some(PrimHit {
+            prim: id,
+            t,
+            b1,
+            b2,
+        })
+    }
+
+    /// `true` when nothing blocks the segment from `o` along `d` over `(tmin, tmax)`.
+    pub fn unoccluded(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> bool {
+        let Some(bvh) = &self.bvh else { return true };
+        bvh.ray_traverse_miss(Self::f32_ray(o, d, tmax), |_, id| {
+            self.prims[id]
+                .intersect(o, d, tmin, tmax)
+                .map_or(f32::INFINITY, |_| 0.0)
+        })
+    }
+
+    /// Full surface data of a hit on primitive `prim`.
+    pub fn surface(&self, scene: &Scene, hit: PrimHit, o: &Vec3, d: &Vec3) -> SurfaceHit {
+        let PrimHit { prim, t, b1, b2 } = hit;
+        let p = o + t * d;
+        let shape = self.prims[prim].shape();
+        match &self.prims[prim] {
+            Primitive::Sphere { center, .. } => {
+                let n = (p - center).normalize();
+                let u = (n.y.atan2(n.x) / std::f64::consts::TAU).rem_euclid(1.0);
+                let v = n.z.clamp(-1.0, 1.0).acos() / std::f64::consts::PI;
+                SurfaceHit {
+                    p,
+                    ng: n,
+                    ns: n,
+                    uv: [u, v],
+                    shape,
+                }
+            }
+            Primitive::Triangle { index, p: v, .. } => {
+                let Geometry::Mesh(mesh) = &scene.shapes[shape].geometry else {
+                    unreachable!("triangle of a non-mesh shape")
+                };
+                let tri = mesh.triangles[*index as usize].map(|i| i as usize);
+                let w = [1.0 - b1 - b2, b1, b2];
+                let mut ng = (v[1] - v[0]).cross(&(v[2] - v[0])).normalize();
+                let ns = if mesh.normals.is_empty() {
+                    ng
+                } else {
+                    let n: Vec3 = (0..3).map(|k| mesh.normals[tri[k]] * w[k]).sum();
+                    let n = n.try_normalize(1e-12).unwrap_or(ng);
+                    if n.dot(&ng) < 0.0 {
+                        ng = -ng;
+                    }
+                    n
+                };
+                let uv = if mesh.uvs.is_empty() {
+                    [b1, b2]
+                } else {
+                    [0, 1].map(|c| (0..3).map(|k| mesh.uvs[tri[k]][c] * w[k]).sum())
+                };
+                SurfaceHit {
+                    p,
+                    ng,
+                    ns,
+                    uv,
+                    shape,
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,365 @@
+//! The scene as the renderer sees it, built from a scene file
+//! ([`crate::scene_file`]) or in code (the procedural dataset generator).
+//!
+//! Units: world distances are arbitrary but consistent; radiance and
+//! irradiance are monochromatic. Emitted Stokes vectors are given relative to
+//! `S0` in the implicit frame `x = polar_optics::stokes_basis(k)` of the
+//! propagation direction `k` (as Mitsuba 3 does for its polarized emitters).
+
+use crate::{Error, Material};
+use nalgebra::{Matrix4, Vector3};
+use std::path::Path;
+
+/// A 3-vector in world space.
+pub type Vec3 = Vector3<f64>;
+
+/// Pinhole camera; `fov_deg` is the horizontal field of view (Mitsuba's
+/// default `fov_axis = "x"`). The image is `width × height`, row 0 on top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    /// Centre of projection.
+    pub position: Vec3,
+    /// A point the optical axis passes through.
+    pub look_at: Vec3,
+    /// Up direction (need not be orthogonal to the view direction).
+    pub up: Vec3,
+    /// Horizontal field of view in degrees, in `(0, 180)`.
+    pub fov_deg: f64,
+    /// Image width in pixels.
+    pub width: usize,
+    /// Image height in pixels.
+    pub height: usize,
+}
+
+/// Sampling settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Seed of the per-pixel sample streams.
+    pub seed: u64,
+    /// Maximum number of scattering events on a path (1 = direct lighting only).
+    pub max_depth: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            spp: 64,
+            seed: 0,
+            max_depth: 8,
+        }
+    }
+}
+
+/// Emitted radiance with an optional polarization state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emission {
+    /// Radiance `S0` (for a sun: irradiance on a surface facing it).
+    pub value: f64,
+    /// `(S1, S2, S3) / S0` in the implicit frame of the propagation direction;
+    /// zero (unpolarized) by default.
+    pub polarization: [f64; 3],
+}
+
+impl Emission {
+    /// Unpolarized emission of strength `value`.
+    pub fn unpolarized(value: f64) -> Self {
+        Self {
+            value,
+            polarization: [0.0; 3],
+        }
+    }
+
+    /// The emitted Stokes vector.
+    pub fn stokes(&self) -> polar_optics::Stokes {
+        let [s1, s2, s3] = self.polarization;
+        polar_optics::Stokes::new(1.0, s1, s2, s3) * self.value
+    }
+}
+
+/// A light that is not a shape: area lights are shapes with an [`Emission`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    /// Constant radiance arriving from every direction (infinitely far).
+    Environment(Emission),
+    /// A directional light: light arrives *from* `direction` (unit, pointing
+    /// toward the sun), so it travels along `-direction`.
+    Sun {
+        /// Direction toward the sun (normalised on use).
+        direction: Vec3,
+        /// Irradiance on a surface facing the sun, with its polarization.
+        emission: Emission,
+    },
+}
+
+/// An indexed triangle mesh in world space.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (empty: flat shading from the winding order).
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates (empty: barycentric coordinates are used).
+    pub uvs: Vec<[f64; 2]>,
+    /// Counter-clockwise triangles (seen from the front), indices into the vertices.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    /// Applies an affine transform (normals by the inverse transpose).
+    pub fn transformed(mut self, m: &Matrix4<f64>) -> Self {
+        let lin = m.fixed_view::<3, 3>(0, 0).into_owned();
+        let normal_m = lin.try_inverse().map(|i| i.transpose()).unwrap_or(lin);
+        let t = m.fixed_view::<3, 1>(0, 3).into_owned();
+        self.positions.iter_mut().for_each(|p| *p = lin * *p + t);
+        self.normals
+            .iter_mut()
+            .for_each(|n| *n = (normal_m * *n).normalize());
+        if lin.determinant() < 0.0 {
+            self.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+        }
+        self
+    }
+}
+
+/// The geometry of a shape.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Geometry {
+    /// An analytic sphere (exact normals and silhouette, like Mitsuba's `sphere`).
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius, > 0.
+        radius: f64,
+    },
+    /// A triangle mesh.
+    Mesh(TriangleMesh),
+}
+
+/// A shape: geometry, its material and, for area lights, its emission.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shape {
+    /// The geometry.
+    pub geometry: Geometry,
+    /// Index into [`Scene::materials`]; `None` is a black absorber.
+    pub material: Option<usize>,
+    /// Emission from the front side (outward normal), making the shape an area light.
+    pub emission: Option<Emission>,
+    /// `true` for floors, walls and the like: label 0 in the ground truth
+    /// even though they have normals and depth (see the conventions).
+    pub background: bool,
+}
+
+impl Shape {
+    /// A non-emitting object shape with material `material`.
+    pub fn new(geometry: Geometry, material: usize) -> Self {
+        Self {
+            geometry,
+            material: Some(material),
+            emission: None,
+            background: false,
+        }
+    }
+}
+
+/// A complete scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Sampling settings.
+    pub settings: RenderSettings,
+    /// Named materials; shapes refer to them by index.
+    pub materials: Vec<(String, Material)>,
+    /// Shapes.
+    pub shapes: Vec<Shape>,
+    /// Environment and sun lights.
+    pub lights: Vec<Light>,
+    /// Sensor parameters, kept verbatim for the sensor model (polar-sensor).
+    pub sensor: Option<toml::Table>,
+}
+
+impl Scene {
+    /// An empty scene seen by `camera`, with default settings.
+    pub fn new(camera: Camera) -> Self {
+        Self {
+            camera,
+            settings: RenderSettings::default(),
+            materials: Vec::new(),
+            shapes: Vec::new(),
+            lights: Vec::new(),
+            sensor: None,
+        }
+    }
+
+    /// Adds a named material and returns its index for [`Shape::material`].
+    pub fn add_material(&mut self, name: &str, material: Material) -> usize {
+        self.materials.push((name.to_owned(), material));
+        self.materials.len() - 1
+    }
+}
+
+/// Where a scene came from, for error messages of scenes built in code.
+const BUILT_IN_CODE: &str = "<scene built in code>";
+
+impl Scene {
+    /// Checks every value (camera, settings, materials, shapes, lights); errors
+    /// name the key and the reason.
+    pub fn validate(&self) -> Result<(), Error> {
+        self.validate_as(Path::new(BUILT_IN_CODE))
+    }
+
+    /// [`Self::validate`], naming `file` in errors.
+    pub(crate) fn validate_as(&self, file: &Path) -> Result<(), Error> {
+        let bad = |key: String, reason: String| {
+            Err(Error::Invalid {
+                file: file.to_owned(),
+                key,
+                reason,
+            })
+        };
+        let c = &self.camera;
+        for (k, v) in [
+            ("camera.position", &c.position),
+            ("camera.look_at", &c.look_at),
+            ("camera.up", &c.up),
+        ] {
+            if !finite(v) {
+                return bad(k.into(), format!("not finite: {:?}", v.as_slice()));
+            }
+        }
+        if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
+            return bad(
+                "camera.fov_deg".into(),
+                format!("must be in (0, 180), got {}", c.fov_deg),
+            );
+        }
+        if c.width == 0 || c.height == 0 {
+            return bad(
+                "camera.width".into(),
+                format!("image size {}x{} is empty", c.width, c.height),
+            );
+        }
+        let view = c.look_at - c.position;
+        if view.norm() == 0.0 || view.cross(&c.up).norm() <= 1e-9 * view.norm() * c.up.norm() {
+            return bad(
+                "camera.up".into(),
+                "look_at equals position, or up is parallel to the view direction".into(),
+            );
+        }
+        if self.settings.spp == 0 {
+            return bad("render.spp".into(), "must be at least 1".into());
+        }
+        if self.settings.max_depth == 0 {
+            return bad("render.max_depth".into(), "must be at least 1".into());
+        }
+        for (name, m) in &self.materials {
+            if let Err(polar_bsdf::Error::InvalidParameter { field, reason }) = m.validate() {
+                return bad(format!("materials.{name}.{field}"), reason);
+            }
+        }
+        for (i, s) in self.shapes.iter().enumerate() {
+            self.validate_shape(s)
+                .or_else(|(k, r)| bad(format!("shapes[{i}].{k}"), r))?;
+        }
+        let mut environments = 0;
+        for (i, l) in self.lights.iter().enumerate() {
+            let (e, key) = match l {
+                Light::Environment(e) => {
+                    environments += 1;
+                    (e, "radiance")
+                }
+                Light::Sun {
+                    direction,
+                    emission,
+                } => {
+                    if !finite(direction) || direction.norm() == 0.0 {
+                        return bad(
+                            format!("lights[{i}].direction"),
+                            format!(
+                                "must be finite and non-zero, got {:?}",
+                                direction.as_slice()
+                            ),
+                        );
+                    }
+                    (emission, "irradiance")
+                }
+            };
+            check_emission(e).or_else(|(k, r)| {
+                bad(
+                    format!(
+                        "lights[{i}].{}",
+                        if k == "value" { key } else { "polarization" }
+                    ),
+                    r,
+                )
+            })?;
+        }
+        if environments > 1 {
+            return bad(
+                "lights".into(),
+                format!("{environments} environment lights; at most one is allowed"),
+            );
+        }
+        Ok(())
+    }
+
+    fn validate_shape(&self, s: &Shape) -> Result<(), (&'static str, String)> {
+        if let Some(m) = s.material.filter(|m| *m >= self.materials.len()) {
+            return Err((
+                "material",
+                format!("index {m} but only {} materials", self.materials.len()),
+            ));
+        }
+        match &s.geometry {
+            Geometry::Sphere { center, radius } => {
+                if !finite(center) {
+                    return Err(("center", format!("not finite: {:?}", center.as_slice())));
+                }
+                if !(*radius > 0.0 && radius.is_finite()) {
+                    return Err((
+                        "radius",
+                        format!("must be positive and finite, got {radius}"),
+                    ));
+                }
+            }
+            Geometry::Mesh(m) => crate::shapes::check_mesh(m).map_err(|r| ("geometry", r))?,
+        }
+        if let Some(e) = &s.emission {
+            check_emission(e).map_err(|(k, r)| {
+                (
+                    if k == "value" {
+                        "emission"
+                    } else {
+                        "emission_polarization"
+                    },
+                    r,
+                )
+            })?;
+        }
+        Ok(())
+    }
+}
+
+/// Emission must be finite, non-negative and physical (`S1² + S2² + S3² ≤ S0²`).
+fn check_emission(e: &Emission) -> Result<(), (&'static str, String)> {
+    if !(e.value >= 0.0 && e.value.is_finite()) {
+        return Err((
+            "value",
+            format!("must be non-negative and finite, got {}", e.value),
+        ));
+    }
+    let p = e.polarization;
+    if !p.iter().all(|c| c.is_finite()) || p.iter().map(|c| c * c).sum::<f64>() > 1.0 + 1e-12 {
+        return Err((
+            "polarization",
+            format!("(S1, S2, S3)/S0 = {p:?} must be finite with norm at most 1"),
+        ));
+    }
+    Ok(())
+}
+
+fn finite(v: &Vec3) -> bool {
+    v.iter().all(|c| c.is_finite())
+}

@@ -1,0 +1,211 @@
+//! A scene prepared for rendering: BVH, camera, per-shape BSDF lookup and the
+//! light-sampling tables.
+
+use crate::camera::PinholeCamera;
+use crate::geometry::{Accel, SurfaceHit};
+use crate::scene::{Emission, Light, Scene, Vec3};
+use polar_optics::Stokes;
+use std::f64::consts::PI;
+
+/// One light source as the integrator picks it (uniformly among all of them).
+#[derive(Clone, Debug)]
+enum LightRef {
+    /// The constant environment.
+    Environment(Emission),
+    /// A directional light (unit direction toward the sun).
+    Sun(Vec3, Emission),
+    /// An emissive shape: its primitives (indices into `Accel::prims`) with an
+    /// area CDF, and the total area.
+    Area {
+        shape: usize,
+        prims: Vec<usize>,
+        cdf: Vec<f64>,
+        area: f64,
+    },
+}
+
+/// A sampled light direction.
+pub(crate) struct LightSample {
+    /// Unit direction from the shading point toward the light (world).
+    pub wi: Vec3,
+    /// Distance to the light point (infinite for environment and sun).
+    pub dist: f64,
+    /// Incident Stokes vector in the implicit frame of its propagation direction `-wi`.
+    pub stokes: Stokes,
+    /// Solid-angle density including the light choice; for a sun, the choice probability.
+    pub pdf: f64,
+    /// The light is a delta distribution (sun): no MIS.
+    pub is_delta: bool,
+}
+
+/// The prepared scene.
+pub(crate) struct World<'a> {
+    pub scene: &'a Scene,
+    pub accel: Accel,
+    pub camera: PinholeCamera,
+    lights: Vec<LightRef>,
+    environment: Option<Emission>,
+    /// Index in `lights` of each emissive shape (for MIS when a BSDF ray hits it).
+    area_index: Vec<Option<usize>>,
+}
+
+/// Cosine-weighted direction about `n` (Malley's method), in world space.
+fn cosine_direction(n: &Vec3, u: [f64; 2]) -> Vec3 {
+    let r = u[0].sqrt();
+    let phi = 2.0 * PI * u[1];
+    let x = polar_optics::stokes_basis(n);
+    let y = n.cross(&x);
+    x * (r * phi.cos()) + y * (r * phi.sin()) + n * (1.0 - u[0]).max(0.0).sqrt()
+}
+
+impl<'a> World<'a> {
+    /// Builds the BVH and light tables of a validated scene.
+    pub fn new(scene: &'a Scene) -> Self {
+        let accel = Accel::build(scene);
+        let mut lights: Vec<LightRef> = scene
+            .lights
+            .iter()
+            .map(|l| match l {
+                Light::Environment(e) => LightRef::Environment(*e),
+                Light::Sun {
+                    direction,
+                    emission,
+                } => LightRef::Sun(direction.normalize(), *emission),
+            })
+            .collect();
+        let mut area_index = vec![None; scene.shapes.len()];
+        for (s, shape) in scene.shapes.iter().enumerate() {
+            if shape.emission.is_none_or(|e| e.value == 0.0) {
+                continue;
+            }
+            let prims: Vec<usize> = (0..accel.prims.len())
+                .filter(|&p| accel.prims[p].shape() == s)
+                .collect();
+            let cdf: Vec<f64> = prims
+                .iter()
+                .scan(0.0, |acc, &p| {
+                    *acc += accel.prims[p].area();
+                    Some(*acc)
+                })
+                .collect();
+            let area = cdf.last().copied().unwrap_or(0.0);
+            if area > 0.0 {
+                area_index[s] = Some(lights.len());
+                lights.push(LightRef::Area {
+                    shape: s,
+                    prims,
+                    cdf,
+                    area,
+                });
+            }
+        }
+        let environment = scene.lights.iter().find_map(|l| match l {
+            Light::Environment(e) => Some(*e),
+            Light::Sun { .. } => None,
+        });
+        Self {
+            camera: PinholeCamera::new(&scene.camera),
+            scene,
+            accel,
+            lights,
+            environment,
+            area_index,
+        }
+    }
+
+    /// Closest surface along a unit direction.
+    pub fn intersect(&self, o: &Vec3, d: &Vec3) -> Option<SurfaceHit> {
+        let hit = self.accel.closest(o, d, 0.0, f64::INFINITY)?;
+        Some(self.accel.surface(self.scene, hit, o, d))
+    }
+
+    /// Environment radiance (Stokes in the implicit frame), if there is an environment.
+    pub fn environment(&self) -> Option<Stokes> {
+        self.environment.map(|e| e.stokes())
+    }
+
+    /// Emitted Stokes leaving the front side of `hit` toward `-d`.
+    pub fn emitted(&self, hit: &SurfaceHit, d: &Vec3) -> Option<Stokes> {
+        let e = self.scene.shapes[hit.shape].emission?;
+        (hit.ng.dot(d) < 0.0).then(|| e.stokes())
+    }
+
+    fn pick_probability(&self) -> f64 {
+        1.0 / self.lights.len() as f64
+    }
+
+    /// Density (solid angle, with the light choice) with which [`Self::sample_light`]
+    /// would return direction `wi` from a point with shading normal `n` toward the environment.
+    pub fn environment_pdf(&self, n: &Vec3, wi: &Vec3) -> f64 {
+        self.pick_probability() * n.dot(wi).max(0.0) / PI
+    }
+
+    /// Density of reaching `hit` on an emissive shape from `from` by light sampling.
+    pub fn area_pdf(&self, hit: &SurfaceHit, from: &Vec3) -> f64 {
+        let Some(LightRef::Area { area, .. }) = self.area_index[hit.shape].map(|i| &self.lights[i])
+        else {
+            return 0.0;
+        };
+        let to = hit.p - from;
+        let cos = hit.ng.dot(&to.normalize()).abs();
+        if cos == 0.0 {
+            0.0
+        } else {
+            self.pick_probability() * to.norm_squared() / (cos * area)
+        }
+    }
+
+    /// Samples one light as seen from `p` with shading normal `n` (visibility not tested).
+    pub fn sample_light(&self, p: &Vec3, n: &Vec3, u: [f64; 3]) -> Option<LightSample> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let pick = self.pick_probability();
+        let index = ((u[0] * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
+        match &self.lights[index] {
+            LightRef::Environment(e) => {
+                let wi = cosine_direction(n, [u[1], u[2]]);
+                let pdf = self.environment_pdf(n, &wi);
+                (pdf > 0.0).then(|| LightSample {
+                    wi,
+                    dist: f64::INFINITY,
+                    stokes: e.stokes(),
+                    pdf,
+                    is_delta: false,
+                })
+            }
+            LightRef::Sun(dir, e) => Some(LightSample {
+                wi: *dir,
+                dist: f64::INFINITY,
+                stokes: e.stokes(),
+                pdf: pick,
+                is_delta: true,
+            }),
+            LightRef::Area {
+                shape,
+                prims,
+                cdf,
+                area,
+            } => {
+                // Reuse u[1] to pick the primitive, then rescale it for the point.
+                let target = u[1] * area;
+                let k = cdf.partition_point(|c| *c <= target).min(prims.len() - 1);
+                let lo = if k == 0 { 0.0 } else { cdf[k - 1] };
+                let v = ((target - lo) / (cdf[k] - lo)).clamp(0.0, 1.0);
+                let (q, nl) = self.accel.prims[prims[k]].sample_point([v, u[2]]);
+                let to = q - p;
+                let dist = to.norm();
+                let wi = to / dist;
+                let cos = -nl.dot(&wi);
+                let e = self.scene.shapes[*shape].emission?;
+                (cos > 0.0 && dist > 0.0).then(|| LightSample {
+                    wi,
+                    dist,
+                    stokes: e.stokes(),
+                    pdf: pick * dist * dist / (cos * area),
+                    is_delta: false,
+                })
+            }
+        }
+    }
+}
