@@ -12,6 +12,7 @@
 //! from intensities, DoLP, AoLP, Mueller matrices) comes from `polar-optics`.
 
 pub mod demosaic;
+pub mod fastmath;
 pub mod layout;
 pub mod mask;
 pub mod picture;

@@ -3,15 +3,16 @@
 //! For `bilinear` the chain is fused: each rayon task takes one mosaic row,
 //! interpolates, forms Stokes and DoLP/AoLP while the row is in cache, so the
 //! four polarizer images are never written to memory. Other methods demosaic
-//! first and then apply the same per-pixel formulas. The formulas are those of
-//! `polar_optics::stokes` (`linear_stokes_from_quad`, `dolp`, `aolp`).
+//! first and then apply the same per-pixel formulas: `linear_stokes_from_quad` of
+//! `polar_optics::stokes`, and its `dolp`/`aolp` in the vectorisable form of [`crate::fastmath`].
 
 use polar_image::{Gray, LinearStokesImage, PolarizerStack};
-use polar_optics::stokes::{aolp, dolp, linear_stokes_from_quad};
+use polar_optics::stokes::linear_stokes_from_quad;
 use rayon::prelude::*;
 
 use crate::demosaic::bilinear::bilinear_stokes_row;
 use crate::demosaic::{DemosaicMethod, demosaic};
+use crate::fastmath::dolp_aolp_row;
 use crate::layout::{Mosaic, MosaicSample};
 use crate::{SensorError, check_mosaic_size};
 
@@ -111,10 +112,7 @@ impl StokesPlanes {
 /// DoLP and AoLP of one row of Stokes values (NaN where `S0 <= 0` or not finite).
 #[inline]
 fn derived_row(s0: &[f32], s1: &[f32], s2: &[f32], d: &mut [f32], a: &mut [f32]) {
-    for x in 0..s0.len() {
-        d[x] = dolp(s0[x], s1[x], s2[x]);
-        a[x] = aolp(s0[x], s1[x], s2[x]);
-    }
+    dolp_aolp_row(s0, s1, s2, d, a);
 }
 
 /// Raw mosaic -> `S0, S1, S2, DoLP, AoLP`, allocating the output.

@@ -16,7 +16,6 @@
 //! (nearest neighbour) instead.
 
 use polar_image::PolarizerStack;
-use polar_optics::stokes::linear_stokes_from_quad;
 use rayon::prelude::*;
 
 use crate::layout::{Mosaic, MosaicSample, channel_at, offset_of};
@@ -68,13 +67,16 @@ pub(crate) fn bilinear<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
     out
 }
 
-/// Which role (0 own, 1 left/right, 2 up/down, 3 diagonal) carries each channel
-/// `I0, I45, I90, I135`, for a pixel at row parity `py` and column parity `px`:
-/// `ROLE_OF[py][px][c]`. Follows from the layout `[[90, 45], [135, 0]]`.
-const ROLE_OF: [[[usize; 4]; 2]; 2] = [[[3, 1, 0, 2], [2, 0, 1, 3]], [[1, 3, 2, 0], [0, 2, 3, 1]]];
-
 /// Linear Stokes `S0, S1, S2` of one mosaic row `y` after bilinear demosaicing,
 /// without materialising the four images: the fused kernel of [`crate::products`].
+///
+/// Per pixel, with the roles of [`bilinear_at`] (own sample `o`, left/right mean `h`,
+/// up/down mean `v`, diagonal mean `d`): `S0 = (o + h + v + d) / 2` and, from the
+/// layout `[[90, 45], [135, 0]]`, with `A = d − o` and `B = h − v`:
+/// `(S1, S2) = (A, B)` at (even row, even column), `(−B, −A)` at (even, odd),
+/// `(B, A)` at (odd, even), `(−A, −B)` at (odd, odd) — i.e. `S1 = I0 − I90`,
+/// `S2 = I45 − I135` of `linear_stokes_from_quad` (a test checks equality).
+/// Written as uniform loops over the row so that they vectorise.
 ///
 /// Each output slice has the mosaic width; `w, h >= 4` (smaller frames use
 /// [`bilinear_at`] per pixel).
@@ -86,15 +88,40 @@ pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
     [s0, s1, s2]: [&mut [f32]; 3],
 ) {
     let yc = y.clamp(1, h - 2);
-    let rows = [
-        &src[(yc - 1) * w..yc * w],
-        &src[yc * w..(yc + 1) * w],
-        &src[(yc + 1) * w..(yc + 2) * w],
-    ];
-    if yc & 1 == 0 {
-        stokes_row_interior::<T, 0>(rows, s0, s1, s2);
-    } else {
-        stokes_row_interior::<T, 1>(rows, s0, s1, s2);
+    let row = |r: usize| &src[r * w..(r + 1) * w];
+    let (up, mid, dn) = (row(yc - 1), row(yc), row(yc + 1));
+    let n = w - 2;
+    // Every slice re-cut to exactly `n` so that the loop has no bounds checks and vectorises.
+    fn cut<T>(s: &[T], start: usize, n: usize) -> &[T] {
+        &s[start..start + n]
+    }
+    let at = |s, start| cut(s, start, n);
+    let (o, ml, mr, uc, dc) = (at(mid, 1), at(mid, 0), at(mid, 2), at(up, 1), at(dn, 1));
+    let (ul, ur, dl, dr) = (at(up, 0), at(up, 2), at(dn, 0), at(dn, 2));
+    let (s0i, ai, bi) = (&mut s0[1..n + 1], &mut s1[1..n + 1], &mut s2[1..n + 1]);
+    let u = |s: &[T], i: usize| -> i32 { Into::<u32>::into(s[i]) as i32 };
+    let (s0i, ai, bi) = (&mut s0i[..n], &mut ai[..n], &mut bi[..n]);
+    for i in 0..n {
+        // Sums of at most four 16-bit samples fit in i32; i32 -> f32 is one instruction.
+        let own = u(o, i);
+        let hor = (u(ml, i) + u(mr, i) + 1) >> 1;
+        let ver = (u(uc, i) + u(dc, i) + 1) >> 1;
+        let dia = (u(ul, i) + u(ur, i) + u(dl, i) + u(dr, i) + 2) >> 2;
+        let [o, h, v, d] = [own, hor, ver, dia].map(|r| r as f32);
+        s0i[i] = 0.5 * (o + h + v + d);
+        ai[i] = d - o;
+        bi[i] = h - v;
+    }
+    // Interior column x = i + 1: pairs (odd x, even x) start at i = 0.
+    let odd_row = yc & 1 == 1;
+    for (a, b) in ai.chunks_exact_mut(2).zip(bi.chunks_exact_mut(2)) {
+        // Odd column: (−B, −A) on even rows, (−A, −B) on odd rows.
+        let (a0, b0) = (a[0], b[0]);
+        (a[0], b[0]) = if odd_row { (-a0, -b0) } else { (-b0, -a0) };
+        // Even column: (A, B) on even rows, (B, A) on odd rows.
+        if odd_row {
+            (a[1], b[1]) = (b[1], a[1]);
+        }
     }
     for s in [s0, s1, s2] {
         s[0] = s[1];
@@ -102,55 +129,17 @@ pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
     }
 }
 
-/// Interior columns `1..w-1` of [`bilinear_stokes_row`] for row parity `PY`,
-/// two pixels (odd column, even column) per step so that roles are compile-time.
-#[inline(always)]
-fn stokes_row_interior<T: MosaicSample, const PY: usize>(
-    [up, mid, dn]: [&[T]; 3],
-    s0: &mut [f32],
-    s1: &mut [f32],
-    s2: &mut [f32],
-) {
-    let w = mid.len();
-    let v = |r: &[T], i: usize| -> u32 { r[i].into() };
-    for k in 0..(w - 2) / 2 {
-        for (j, px) in [(0, 1), (1, 0)] {
-            let x = 2 * k + 1 + j;
-            let roles = [
-                v(mid, x),
-                (v(mid, x - 1) + v(mid, x + 1) + 1) >> 1,
-                (v(up, x) + v(dn, x) + 1) >> 1,
-                (v(up, x - 1) + v(up, x + 1) + v(dn, x - 1) + v(dn, x + 1) + 2) >> 2,
-            ]
-            .map(|r| r as f32);
-            let q = ROLE_OF[PY][px];
-            let [a, b, c] =
-                linear_stokes_from_quad(roles[q[0]], roles[q[1]], roles[q[2]], roles[q[3]]);
-            (s0[x], s1[x], s2[x]) = (a, b, c);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// `ROLE_OF` must agree with the layout: the role at offset (dx, dy) carries `channel_at(x+dx, y+dy)`.
-    #[test]
-    fn role_table_matches_layout() {
-        for (py, px) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-            for (r, (dx, dy)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
-                let c = channel_at(px + dx, py + dy);
-                assert_eq!(ROLE_OF[py][px][c], r, "parity ({px},{py}) channel {c}");
-            }
-        }
-    }
+    use polar_optics::stokes::linear_stokes_from_quad;
 
     #[test]
     fn fused_row_equals_stokes_of_demosaiced_pixels() {
         let (w, h) = (10, 8);
         let src: Vec<u16> = (0..w * h).map(|i| ((i * 7919) % 4093) as u16).collect();
         for y in 0..h {
+            // Every parity of row and column is covered (all four super-pixel positions).
             let (mut a, mut b, mut c) = (vec![0.0; w], vec![0.0; w], vec![0.0; w]);
             bilinear_stokes_row(&src, w, h, y, [&mut a, &mut b, &mut c]);
             for x in 0..w {
