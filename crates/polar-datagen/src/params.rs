@@ -70,7 +70,7 @@ pub struct CameraParams {
     pub distance: f64,
     /// Elevation above the ground plane, degrees.
     pub elevation_deg: f64,
-    /// Vertical field of view, degrees.
+    /// Horizontal field of view, degrees.
     pub fov_deg: f64,
 }
 
@@ -90,7 +90,7 @@ pub struct LightParams {
 /// The ground plane (opaque families) or backdrop (transparent family).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BackgroundParams {
-    /// `plain`, `checker` or `stripes`.
+    /// `plain` or `checker`.
     pub pattern: String,
     /// Pattern repetitions across the plane.
     pub scale: f64,

@@ -41,12 +41,17 @@ pub struct Suite {
 pub struct NoiseLevel {
     /// Name referred to by families, e.g. `clean` or `realistic`.
     pub name: String,
-    /// Electrons collected at S0 = 1 behind an open pixel; 0 turns shot noise off.
+    /// Full-well capacity, electrons; auto-exposure puts the 99th percentile of S0 at 80 % of it.
     pub full_well_e: f64,
     /// Gaussian read noise, electrons RMS.
     pub read_noise_e: f64,
-    /// ADC bit depth of the raw mosaic (8..=16).
+    /// ADC bit depth of the raw mosaic (8..=16); the gain maps the full well to the ADC range.
     pub bits: u8,
+    /// Poisson photon shot noise on or off.
+    pub shot_noise: bool,
+    /// Micro-polarizer extinction ratio T_max / T_min; absent = ideal polarizers.
+    #[serde(default)]
+    pub extinction_ratio: Option<f64>,
 }
 
 /// What a family of samples is for; decides its parameters and scene layout.
@@ -218,7 +223,7 @@ const COMMON: &[ParamSpec] = &[
         "fov_deg",
         [30.0, 40.0],
         [5.0, 120.0],
-        "vertical field of view, degrees",
+        "horizontal field of view, degrees",
     ),
     p(
         "light_elevation_deg",
@@ -399,7 +404,7 @@ const SHAPES: &[&str] = &["sphere", "superquadric", "blob", "torus", "extrusion"
 const GLASS_SHAPES: &[&str] = &["sphere", "slab", "torus", "extrusion"];
 const MATERIALS: &[&str] = &["dielectric", "metal", "textured"];
 const METALS: &[&str] = &["gold", "silver", "aluminium", "copper"];
-const BACKGROUNDS: &[&str] = &["checker", "stripes"];
+const BACKGROUNDS: &[&str] = &["checker", "plain"];
 
 /// The categorical parameters of a kind.
 pub fn choice_specs(kind: FamilyKind) -> &'static [ChoiceSpec] {
@@ -427,7 +432,11 @@ pub fn choice_specs(kind: FamilyKind) -> &'static [ChoiceSpec] {
     ];
     const TRANSPARENT_C: &[ChoiceSpec] = &[
         c("shape", GLASS_SHAPES, "shape of each glass object"),
-        c("background", BACKGROUNDS, "pattern of the background plane"),
+        c(
+            "background",
+            BACKGROUNDS,
+            "pattern of the backdrop behind the glass",
+        ),
     ];
     match kind {
         FamilyKind::Shape => SHAPE_C,
@@ -556,8 +565,14 @@ impl Suite {
 }
 
 fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
-    if !(n.full_well_e.is_finite() && n.full_well_e >= 0.0) {
-        return Err(format!("full_well_e = {} must be >= 0", n.full_well_e));
+    if !(n.full_well_e.is_finite() && n.full_well_e >= 1.0) {
+        return Err(format!(
+            "full_well_e = {} must be >= 1 electron",
+            n.full_well_e
+        ));
+    }
+    if let Some(er) = n.extinction_ratio.filter(|er| er.is_nan() || *er < 1.0) {
+        return Err(format!("extinction_ratio = {er} must be >= 1"));
     }
     if !(n.read_noise_e.is_finite() && n.read_noise_e >= 0.0) {
         return Err(format!("read_noise_e = {} must be >= 0", n.read_noise_e));
@@ -597,9 +612,10 @@ name = "mini"
 seed = 7
 [[noise]]
 name = "clean"
-full_well_e = 0
+full_well_e = 60000
 read_noise_e = 0
 bits = 16
+shot_noise = false
 [[family]]
 name = "sfp"
 kind = "shape"

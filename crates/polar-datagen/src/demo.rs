@@ -1,0 +1,211 @@
+//! The built-in demo scene and single-scene rendering (`demo` and `render` commands): one
+//! sample directory, committed atomically, plus quick-look pictures.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::Error;
+use crate::params::{
+    BackgroundParams, CameraParams, LightParams, MaterialParams, ObjectParams, SampleParams,
+    ShapeParams,
+};
+use crate::sample::{render, write_pictures, write_sample};
+use crate::scene::build_scene;
+use crate::store;
+use crate::suite::{FamilyKind, NoiseLevel};
+
+/// A Sony IMX250MZR-like sensor in 12-bit mode: full well ~10 500 e-, read noise ~2.3 e-,
+/// extinction ratio ~300 (Sony's datasheet figures at 525 nm).
+pub fn realistic_noise() -> NoiseLevel {
+    NoiseLevel {
+        name: "realistic".into(),
+        full_well_e: 10_500.0,
+        read_noise_e: 2.3,
+        bits: 12,
+        shot_noise: true,
+        extinction_ratio: Some(300.0),
+    }
+}
+
+fn object(
+    shape: ShapeParams,
+    material: MaterialParams,
+    size: f64,
+    rotation_deg: [f64; 3],
+) -> ObjectParams {
+    ObjectParams {
+        shape,
+        material,
+        position: [0.0, size, 0.0],
+        rotation_deg,
+        size,
+    }
+}
+
+/// The demo: a plastic sphere, a gold superquadric, a glass sphere and a checkered torus on a
+/// grey floor before a checkered backdrop, lit by a low sun and a dim sky.
+pub fn demo_params(width: u32, height: u32, spp: u32) -> SampleParams {
+    let mut objects = vec![
+        object(
+            ShapeParams::Sphere,
+            MaterialParams::Dielectric {
+                ior: 1.5,
+                roughness: 0.05,
+                albedo: 0.6,
+            },
+            0.45,
+            [0.0; 3],
+        ),
+        object(
+            ShapeParams::Superquadric { e1: 0.5, e2: 0.5 },
+            MaterialParams::Metal {
+                metal: "gold".into(),
+                roughness: 0.15,
+            },
+            0.45,
+            [20.0, 30.0, 0.0],
+        ),
+        object(
+            ShapeParams::Sphere,
+            MaterialParams::Glass {
+                ior: 1.5,
+                roughness: 0.0,
+            },
+            0.45,
+            [0.0; 3],
+        ),
+        object(
+            ShapeParams::Torus { minor_ratio: 0.35 },
+            MaterialParams::Textured {
+                ior: 1.45,
+                roughness: 0.2,
+                albedo: [0.15, 0.75],
+                scale: 4.0,
+            },
+            0.45,
+            [0.0, 25.0, 0.0],
+        ),
+    ];
+    for (i, o) in objects.iter_mut().enumerate() {
+        o.position[0] = (i as f64 - 1.5) * 1.0;
+    }
+    SampleParams {
+        id: "demo".into(),
+        family: "demo".into(),
+        kind: FamilyKind::Transparent,
+        index: 0,
+        seed: 1,
+        width,
+        height,
+        spp,
+        noise: realistic_noise(),
+        camera: CameraParams {
+            distance: 4.2,
+            elevation_deg: 15.0,
+            fov_deg: 45.0,
+        },
+        light: LightParams {
+            elevation_deg: 35.0,
+            azimuth_deg: 60.0,
+            intensity: 3.0,
+            ambient: 0.2,
+        },
+        background: BackgroundParams {
+            pattern: "checker".into(),
+            scale: 24.0,
+            albedo: [0.2, 0.7],
+        },
+        objects,
+    }
+}
+
+/// Checks that `dir` can become a sample directory: absent, empty or an earlier sample
+/// (has meta.json), with a writable parent. Called before rendering.
+pub fn check_sample_target(dir: &Path) -> Result<(), Error> {
+    if dir.exists() {
+        let empty = std::fs::read_dir(dir)
+            .map_err(Error::io(dir))?
+            .next()
+            .is_none();
+        if !empty && !dir.join("meta.json").exists() {
+            return Err(Error::OutputNotWritable {
+                path: dir.to_owned(),
+                source: std::io::Error::other(
+                    "exists and is not a sample directory (no meta.json); refusing to replace it",
+                ),
+            });
+        }
+    }
+    store::ensure_writable(&parent_of(dir))
+}
+
+fn parent_of(dir: &Path) -> PathBuf {
+    dir.parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .map_or_else(|| PathBuf::from("."), Path::to_owned)
+}
+
+/// Renders the demo into `out` (a sample directory with `pictures/`); returns the model name.
+pub fn run_demo(out: &Path, width: u32, height: u32, spp: u32) -> Result<String, Error> {
+    let params = demo_params(width, height, spp);
+    let scene = build_scene(&params);
+    let record = serde_json::to_value(&params).unwrap_or_default();
+    render_into(out, &scene, &params.noise, &record)
+}
+
+/// Sensor settings in a scene file's `[sensor]` table; absent keys take the realistic values.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SensorTable {
+    full_well_e: Option<f64>,
+    read_noise_e: Option<f64>,
+    bits: Option<u8>,
+    shot_noise: Option<bool>,
+    extinction_ratio: Option<f64>,
+}
+
+/// The noise level of a scene file's `[sensor]` table (realistic defaults).
+pub fn noise_from_table(table: Option<&toml::Table>, file: &Path) -> Result<NoiseLevel, Error> {
+    let r = realistic_noise();
+    let Some(t) = table else { return Ok(r) };
+    let s: SensorTable = t
+        .clone()
+        .try_into()
+        .map_err(|e: toml::de::Error| Error::Suite {
+            path: file.to_owned(),
+            message: format!("[sensor]: {e}"),
+        })?;
+    Ok(NoiseLevel {
+        name: "scene".into(),
+        full_well_e: s.full_well_e.unwrap_or(r.full_well_e),
+        read_noise_e: s.read_noise_e.unwrap_or(r.read_noise_e),
+        bits: s.bits.unwrap_or(r.bits),
+        shot_noise: s.shot_noise.unwrap_or(r.shot_noise),
+        extinction_ratio: s.extinction_ratio.or(r.extinction_ratio),
+    })
+}
+
+/// Renders `scene` into the sample directory `out`, atomically (sibling staging dir, rename).
+pub fn render_into(
+    out: &Path,
+    scene: &polar_render::Scene,
+    noise: &NoiseLevel,
+    record: &serde_json::Value,
+) -> Result<String, Error> {
+    check_sample_target(out)?;
+    let parent = parent_of(out);
+    let name = out
+        .file_name()
+        .map_or_else(|| "sample".into(), |n| n.to_string_lossy().into_owned());
+    let staged = parent.join(format!(".{name}.staging"));
+    if staged.exists() {
+        std::fs::remove_dir_all(&staged).map_err(Error::io(&staged))?;
+    }
+    std::fs::create_dir_all(&staged).map_err(Error::io(&staged))?;
+    let result = render(scene, &name)?;
+    write_sample(&staged, scene, &result, noise, record, &name)?;
+    write_pictures(&staged.join("pictures"), &result.stokes)?;
+    store::commit_dir(&parent, &staged, &name)?;
+    Ok(format!("{:?}", result.model))
+}

@@ -1,0 +1,240 @@
+//! The per-sample work with the real renderer: scene -> `polar_render::render` -> sensor ->
+//! files of the sample format (`conventions.md`), written into the given directory.
+
+use std::path::Path;
+
+use polar_image::{Gray, Image, StokesImage};
+use polar_render::{RenderOptions, RenderOutput, Scene};
+use polar_sensor::SensorModel;
+use serde::Serialize;
+
+use crate::Error;
+use crate::params::SampleParams;
+use crate::run::{SampleWorker, WorkReport};
+use crate::scene::build_scene;
+use crate::suite::NoiseLevel;
+
+/// Fraction of the full well that the 99th percentile of S0 reaches (auto-exposure headroom).
+const EXPOSURE_TARGET: f64 = 0.8;
+/// Percentile of S0 used for auto-exposure: ignores a few specular highlights.
+const EXPOSURE_QUANTILE: f64 = 0.99;
+
+/// Renders samples with polar-render and polar-sensor.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderWorker;
+
+impl SampleWorker for RenderWorker {
+    fn produce(&self, params: &SampleParams, dir: &Path) -> Result<WorkReport, Error> {
+        let scene = build_scene(params);
+        let out = render(&scene, &params.id)?;
+        let record = serde_json::to_value(params).unwrap_or_default();
+        write_sample(dir, &scene, &out, &params.noise, &record, &params.id)?;
+        Ok(WorkReport {
+            model: format!("{:?}", out.model),
+            render_seconds: out.seconds,
+        })
+    }
+}
+
+/// Renders a scene, mapping errors to the sample id.
+pub fn render(scene: &Scene, id: &str) -> Result<RenderOutput, Error> {
+    polar_render::render(scene, &RenderOptions::default(), &|_, _| {}).map_err(|e| Error::Sample {
+        id: id.to_owned(),
+        message: e.to_string(),
+    })
+}
+
+/// The sensor of a noise level with auto-exposure for `stokes`, seeded by `seed`.
+pub fn sensor_model(noise: &NoiseLevel, stokes: &StokesImage, seed: u64) -> SensorModel {
+    let max_dn = f64::from((1u32 << noise.bits) - 1);
+    let s0 = stokes.channel(0);
+    let level = polar_sensor::picture::quantile(&s0, EXPOSURE_QUANTILE).map_or(0.0, f64::from);
+    let photons_per_unit = if level > 0.0 {
+        EXPOSURE_TARGET * noise.full_well_e / level
+    } else {
+        1.0
+    };
+    SensorModel {
+        photons_per_unit,
+        extinction_ratio: noise.extinction_ratio.unwrap_or(f64::INFINITY),
+        quantum_efficiency: 1.0,
+        gain: noise.full_well_e / max_dn,
+        read_noise: noise.read_noise_e,
+        full_well: noise.full_well_e,
+        bit_depth: u32::from(noise.bits),
+        black_level: 0,
+        shot_noise: noise.shot_noise,
+        seed: seed ^ 0x5e45_0a5e_5e45_0a5e,
+    }
+}
+
+#[derive(Serialize)]
+struct Meta<'a> {
+    width: usize,
+    height: usize,
+    generator: String,
+    renderer: RendererMeta,
+    sensor: SensorMeta<'a>,
+    camera: CameraMeta,
+    spp: u32,
+    seconds: f64,
+    scene: &'a serde_json::Value,
+}
+
+#[derive(Serialize)]
+struct RendererMeta {
+    name: &'static str,
+    model: String,
+    spp: u32,
+    max_depth: u32,
+    seed: u64,
+}
+
+#[derive(Serialize)]
+struct SensorMeta<'a> {
+    noise: &'a NoiseLevel,
+    photons_per_unit: f64,
+    gain_e_per_dn: f64,
+    bit_depth: u32,
+    black_level: u16,
+    saturated_pixels: usize,
+    seed: u64,
+}
+
+#[derive(Serialize)]
+struct CameraMeta {
+    position: [f64; 3],
+    look_at: [f64; 3],
+    up: [f64; 3],
+    fov_deg: f64,
+    fov_axis: &'static str,
+}
+
+fn io_err(id: &str) -> impl Fn(polar_io::Error) -> Error + '_ {
+    move |e| Error::Sample {
+        id: id.to_owned(),
+        message: e.to_string(),
+    }
+}
+
+/// Writes meta.json, raw.png, stokes.exr and gt/ for one render into `dir`.
+/// `scene_meta` is recorded verbatim as `meta.scene` (the sample parameters or the scene file).
+/// The sensor noise is seeded from the scene's render seed.
+pub fn write_sample(
+    dir: &Path,
+    scene: &Scene,
+    out: &RenderOutput,
+    noise: &NoiseLevel,
+    scene_meta: &serde_json::Value,
+    id: &str,
+) -> Result<(), Error> {
+    let model = sensor_model(noise, &out.stokes, scene.settings.seed);
+    let exposed = model.expose(&out.stokes).map_err(|e| Error::Sample {
+        id: id.to_owned(),
+        message: e.to_string(),
+    })?;
+    let gt = dir.join("gt");
+    std::fs::create_dir_all(&gt).map_err(Error::io(&gt))?;
+    polar_io::write_gray16_png(dir.join("raw.png"), &exposed.raw).map_err(io_err(id))?;
+    polar_io::write_exr(
+        dir.join("stokes.exr"),
+        &out.stokes,
+        polar_io::STOKES_CHANNELS,
+    )
+    .map_err(io_err(id))?;
+    polar_io::write_exr(gt.join("normal.exr"), &out.normal, polar_io::RGB_CHANNELS)
+        .map_err(io_err(id))?;
+    polar_io::write_exr(gt.join("depth.exr"), &out.depth, polar_io::Y_CHANNEL)
+        .map_err(io_err(id))?;
+    polar_io::write_gray8_png(gt.join("material.png"), &out.material).map_err(io_err(id))?;
+    polar_io::write_gray8_png(gt.join("transparent.png"), &out.transparent).map_err(io_err(id))?;
+    let meta = meta(
+        scene,
+        out,
+        noise,
+        &model,
+        exposed.saturated_count,
+        scene_meta,
+    );
+    crate::store::write_json(&dir.join("meta.json"), &meta)
+}
+
+fn meta<'a>(
+    s: &Scene,
+    out: &RenderOutput,
+    noise: &'a NoiseLevel,
+    model: &SensorModel,
+    saturated_pixels: usize,
+    scene: &'a serde_json::Value,
+) -> Meta<'a> {
+    let (width, height) = out.stokes.size();
+    Meta {
+        width,
+        height,
+        generator: format!("polar-datagen {}", env!("CARGO_PKG_VERSION")),
+        renderer: RendererMeta {
+            name: "polar-render",
+            model: format!("{:?}", out.model),
+            spp: out.spp,
+            max_depth: s.settings.max_depth,
+            seed: s.settings.seed,
+        },
+        sensor: SensorMeta {
+            noise,
+            photons_per_unit: model.photons_per_unit,
+            gain_e_per_dn: model.gain,
+            bit_depth: model.bit_depth,
+            black_level: model.black_level,
+            saturated_pixels,
+            seed: model.seed,
+        },
+        camera: CameraMeta {
+            position: s.camera.position.into(),
+            look_at: s.camera.look_at.into(),
+            up: s.camera.up.into(),
+            fov_deg: s.camera.fov_deg,
+            fov_axis: "x",
+        },
+        spp: out.spp,
+        seconds: out.seconds,
+        scene,
+    }
+}
+
+/// DoLP and AoLP of a Stokes image (NaN where S0 is not positive), via polar-optics.
+pub fn dolp_aolp(stokes: &StokesImage) -> (Gray<f32>, Gray<f32>) {
+    let (w, h) = stokes.size();
+    let (mut d, mut a) = (Gray::<f32>::new(w, h), Gray::<f32>::new(w, h));
+    for ((px, dv), av) in stokes
+        .pixels()
+        .iter()
+        .zip(d.as_mut_slice())
+        .zip(a.as_mut_slice())
+    {
+        let [s0, s1, s2, _] = *px;
+        *dv = polar_optics::stokes::dolp(s0, s1, s2);
+        *av = polar_optics::stokes::aolp(s0, s1, s2);
+    }
+    (d, a)
+}
+
+/// Writes pictures/s0.png (viridis, 0 to the 99th percentile), dolp.png (viridis, 0..1) and
+/// aolp.png (hue = AoLP, value = DoLP) for a quick look.
+pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
+    use polar_sensor::picture::{aolp_hsv, colormap, quantile};
+    std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
+    let s0 = stokes.channel(0);
+    let top = quantile(&s0, EXPOSURE_QUANTILE)
+        .unwrap_or(1.0)
+        .max(f32::MIN_POSITIVE);
+    let (dolp, aolp) = dolp_aolp(stokes);
+    let pictures: [(&str, Image<u8, 3>); 3] = [
+        ("s0.png", colormap(&s0, 0.0, top)),
+        ("dolp.png", colormap(&dolp, 0.0, 1.0)),
+        ("aolp.png", aolp_hsv(&aolp, &dolp)),
+    ];
+    for (name, picture) in pictures {
+        polar_io::write_rgb8_png(dir.join(name), &picture).map_err(io_err("pictures"))?;
+    }
+    Ok(())
+}

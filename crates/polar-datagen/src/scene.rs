@@ -1,0 +1,182 @@
+//! From sample parameters to a `polar_render::Scene`: camera on a sphere around the objects,
+//! a sun plus a uniform sky, a ground plane (and a textured backdrop for glass), objects in a row.
+
+use polar_bsdf::{
+    Checkerboard, ConductorParams, DielectricParams, LambertianParams, Material, Metal,
+    PlasticParams, Roughness, Texture,
+};
+use polar_render::scene::Vec3;
+use polar_render::shapes::{cube, rectangle, superquadric, torus, transform};
+use polar_render::{Camera, Emission, Geometry, Light, Scene, Shape};
+
+use crate::mesh::{blob, extrusion};
+use crate::params::{MaterialParams, ObjectParams, SampleParams, ShapeParams};
+use crate::suite::FamilyKind;
+
+/// Tessellation of curved meshes: 48 segments keep the chord error below 0.1 % of the radius.
+const SEGMENTS: u32 = 48;
+/// Half-size of the ground and backdrop planes, m.
+const PLANE: f64 = 30.0;
+/// Path length limit: glass needs entry, exit and the backdrop bounce.
+const MAX_DEPTH: u32 = 12;
+
+/// Unit vector at `elevation` above the ground (y up) and `azimuth` around y from +z, degrees.
+fn direction(elevation_deg: f64, azimuth_deg: f64) -> Vec3 {
+    let (e, a) = (elevation_deg.to_radians(), azimuth_deg.to_radians());
+    Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos())
+}
+
+/// Builds the scene of one sample.
+pub fn build_scene(p: &SampleParams) -> Scene {
+    let height = p.objects.iter().map(|o| o.size).fold(0.5, f64::max);
+    let target = Vec3::new(0.0, height, 0.0);
+    let camera = Camera {
+        position: target + p.camera.distance * direction(p.camera.elevation_deg, 0.0),
+        look_at: target,
+        up: Vec3::y(),
+        fov_deg: p.camera.fov_deg,
+        width: p.width as usize,
+        height: p.height as usize,
+    };
+    let mut scene = Scene::new(camera);
+    scene.settings.spp = p.spp;
+    scene.settings.seed = p.seed;
+    scene.settings.max_depth = MAX_DEPTH;
+    scene
+        .lights
+        .push(Light::Environment(Emission::unpolarized(p.light.ambient)));
+    scene.lights.push(Light::Sun {
+        direction: direction(p.light.elevation_deg, p.light.azimuth_deg),
+        emission: Emission::unpolarized(p.light.intensity),
+    });
+    add_ground(&mut scene, p);
+    for (i, o) in p.objects.iter().enumerate() {
+        let m = scene.add_material(&format!("object{i}"), material(&o.material));
+        scene.shapes.push(Shape::new(geometry(o), m));
+    }
+    scene
+}
+
+fn albedo_texture(p: &SampleParams) -> Texture {
+    let b = &p.background;
+    if b.pattern == "checker" {
+        Texture::Checkerboard(Checkerboard {
+            checkerboard: b.albedo,
+            scale: b.scale,
+        })
+    } else {
+        Texture::Constant(b.albedo[0])
+    }
+}
+
+fn add_ground(scene: &mut Scene, p: &SampleParams) {
+    let lambert = |albedo| Material::Lambertian(LambertianParams { albedo });
+    let ground = scene.add_material("ground", lambert(Texture::Constant(p.background.albedo[0])));
+    let floor = rectangle().transformed(&transform([0.0; 3], [-90.0, 0.0, 0.0], [PLANE; 3]));
+    scene.shapes.push(Shape {
+        background: true,
+        ..Shape::new(Geometry::Mesh(floor), ground)
+    });
+    if p.kind == FamilyKind::Transparent {
+        let back = p.objects.iter().map(|o| o.size).fold(0.5, f64::max) * 2.5;
+        let backdrop = scene.add_material("backdrop", lambert(albedo_texture(p)));
+        let wall = rectangle().transformed(&transform(
+            [0.0, PLANE / 4.0, -back],
+            [0.0; 3],
+            [PLANE / 4.0; 3],
+        ));
+        scene.shapes.push(Shape {
+            background: true,
+            ..Shape::new(Geometry::Mesh(wall), backdrop)
+        });
+    }
+}
+
+fn geometry(o: &ObjectParams) -> Geometry {
+    let place = |mesh: polar_render::TriangleMesh, scale: [f64; 3]| {
+        Geometry::Mesh(mesh.transformed(&transform(o.position, o.rotation_deg, scale)))
+    };
+    let s = o.size;
+    match &o.shape {
+        ShapeParams::Sphere => Geometry::Sphere {
+            center: Vec3::from(o.position),
+            radius: s,
+        },
+        ShapeParams::Superquadric { e1, e2 } => {
+            // The superquadric spans [-1, 1]^3: its corners reach sqrt(3) for small exponents.
+            let reach = 3f64.sqrt().powf(1.0 - e1.min(*e2).min(1.0));
+            place(superquadric(*e1, *e2, SEGMENTS), [s / reach; 3])
+        }
+        ShapeParams::Blob {
+            amplitude,
+            frequency,
+            phase,
+        } => place(blob(*amplitude, *frequency, *phase, SEGMENTS), [s; 3]),
+        ShapeParams::Torus { minor_ratio } => {
+            place(torus(*minor_ratio, SEGMENTS), [s / (1.0 + minor_ratio); 3])
+        }
+        ShapeParams::Extrusion {
+            sides,
+            inner_ratio,
+            depth,
+        } => place(extrusion(*sides, *inner_ratio, *depth), [s; 3]),
+        ShapeParams::Slab { thickness } => {
+            let t = (0.5 * thickness).min(s);
+            place(cube(), [s / 2f64.sqrt(), s / 2f64.sqrt(), t])
+        }
+    }
+}
+
+fn metal(name: &str) -> Metal {
+    match name {
+        "silver" => Metal::Ag,
+        "aluminium" => Metal::Al,
+        "copper" => Metal::Cu,
+        _ => Metal::Au,
+    }
+}
+
+fn material(m: &MaterialParams) -> Material {
+    let plastic = |albedo, ior, roughness: f64| {
+        Material::Plastic(PlasticParams {
+            albedo,
+            ior,
+            ext_ior: 1.0,
+            roughness: Roughness::Isotropic(roughness),
+        })
+    };
+    match m {
+        MaterialParams::Dielectric {
+            ior,
+            roughness,
+            albedo,
+        } => plastic(Texture::Constant(*albedo), *ior, *roughness),
+        MaterialParams::Textured {
+            ior,
+            roughness,
+            albedo,
+            scale,
+        } => plastic(
+            Texture::Checkerboard(Checkerboard {
+                checkerboard: *albedo,
+                scale: *scale,
+            }),
+            *ior,
+            *roughness,
+        ),
+        MaterialParams::Metal {
+            metal: name,
+            roughness,
+        } => Material::Conductor(ConductorParams {
+            metal: Some(metal(name)),
+            n: None,
+            k: None,
+            roughness: Roughness::Isotropic(*roughness),
+        }),
+        MaterialParams::Glass { ior, roughness } => Material::Dielectric(DielectricParams {
+            ior: *ior,
+            ext_ior: 1.0,
+            roughness: Roughness::Isotropic(*roughness),
+        }),
+    }
+}
