@@ -138,16 +138,34 @@ pub(crate) fn correlate<'a>(k: &[f32], tap: impl Fn(usize) -> &'a [f32], out: &m
     let symmetric = (0..r).all(|i| k[i] == k[n - 1 - i]);
     let antisymmetric = k[r] == 0.0 && (0..r).all(|i| k[i] == -k[n - 1 - i]);
     if symmetric || antisymmetric {
+        // b enters as sgn * b (exact for sgn = +-1); two tap pairs per pass over `out`.
+        let sgn = if symmetric { 1.0f32 } else { -1.0 };
         let kr = k[r];
-        out.iter_mut().zip(tap(r)).for_each(|(o, &v)| *o = kr * v);
-        for (i, &ki) in k[..r].iter().enumerate() {
-            let (a, b) = (tap(i), tap(n - 1 - i));
-            let pairs = out.iter_mut().zip(a.iter().zip(b));
-            if symmetric {
-                pairs.for_each(|(o, (&a, &b))| *o += ki * (a + b));
-            } else {
-                pairs.for_each(|(o, (&a, &b))| *o += ki * (a - b));
+        let pair = |i: usize| (k[i], tap(i), tap(n - 1 - i));
+        match r {
+            0 => out.iter_mut().zip(tap(0)).for_each(|(o, &v)| *o = kr * v),
+            _ => {
+                let (k0, a0, b0) = pair(0);
+                out.iter_mut()
+                    .zip(tap(r).iter().zip(a0.iter().zip(b0)))
+                    .for_each(|(o, (&c, (&a, &b)))| *o = kr * c + k0 * (a + sgn * b));
             }
+        }
+        let mut i = 1;
+        while i + 1 < r {
+            let ((ki, ai, bi), (kj, aj, bj)) = (pair(i), pair(i + 1));
+            out.iter_mut()
+                .zip(ai.iter().zip(bi).zip(aj.iter().zip(bj)))
+                .for_each(|(o, ((&a, &b), (&c, &d)))| {
+                    *o += ki * (a + sgn * b) + kj * (c + sgn * d)
+                });
+            i += 2;
+        }
+        if i < r {
+            let (ki, ai, bi) = pair(i);
+            out.iter_mut()
+                .zip(ai.iter().zip(bi))
+                .for_each(|(o, (&a, &b))| *o += ki * (a + sgn * b));
         }
         return;
     }
