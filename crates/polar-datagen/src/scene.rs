@@ -180,3 +180,28 @@ fn material(m: &MaterialParams) -> Material {
         }),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::draw_params;
+    use crate::suite::{SizeName, Suite};
+
+    #[test]
+    fn every_drawn_scene_of_the_standard_suite_validates() {
+        let text = include_str!("../../../datasets-synth/suites/standard.toml");
+        let suite = Suite::parse(text).unwrap();
+        for f in suite
+            .families
+            .iter()
+            .filter(|f| f.kind.pending_reason().is_none())
+        {
+            for i in 0..60 {
+                let p = draw_params(&suite, f, SizeName::Ci, i);
+                if let Err(e) = build_scene(&p).validate() {
+                    panic!("{} {e}: {:?}", p.id, p.objects);
+                }
+            }
+        }
+    }
+}

@@ -273,9 +273,9 @@ const SHAPE: &[ParamSpec] = &[
     ),
     p(
         "superquadric_exponent",
-        [0.3, 2.5],
-        [0.1, 4.0],
-        "superquadric exponents e1, e2 (1 = sphere)",
+        [0.3, 1.9],
+        [0.1, 1.95],
+        "superquadric exponents e1, e2 (1 = sphere; < 2 keeps normals finite)",
     ),
     p(
         "blob_amplitude",

@@ -1,0 +1,286 @@
+//! End-to-end behaviour of the real `polar-datagen` binary in temporary directories, with tiny
+//! images and low spp so each test takes seconds.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const TINY: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../datasets-synth/suites/tiny.toml"
+);
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_polar-datagen"))
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("binary runs")
+}
+
+fn run_ok(args: &[&str]) -> Output {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 temp path")
+}
+
+/// Every image file (not meta.json, which records timings) under the sample dirs, by path.
+fn images(dataset: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dataset.to_owned()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let rel = p
+                .strip_prefix(dataset)
+                .unwrap()
+                .to_string_lossy()
+                .into_owned();
+            if p.is_dir() {
+                stack.push(p);
+            } else if rel.ends_with(".png") || rel.ends_with(".exr") {
+                out.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+fn manifest_ids(dataset: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dataset.join("manifest.jsonl")).unwrap();
+    text.lines()
+        .map(|l| {
+            serde_json::from_str::<serde_json::Value>(l).unwrap()["id"]
+                .as_str()
+                .unwrap()
+                .to_owned()
+        })
+        .collect()
+}
+
+#[test]
+fn images_are_byte_identical_whatever_the_jobs_or_shards() {
+    let t = tempfile::tempdir().unwrap();
+    let (a, b) = (t.path().join("jobs1"), t.path().join("jobs2"));
+    run_ok(&["suite", TINY, "--out", s(&a), "--jobs", "1", "--quiet"]);
+    run_ok(&["suite", TINY, "--out", s(&b), "--jobs", "2", "--quiet"]);
+    let (s1, s2, merged) = (
+        t.path().join("s1"),
+        t.path().join("s2"),
+        t.path().join("merged"),
+    );
+    run_ok(&["suite", TINY, "--out", s(&s1), "--shard", "1/2", "--quiet"]);
+    run_ok(&["suite", TINY, "--out", s(&s2), "--shard", "2/2", "--quiet"]);
+    run_ok(&["merge", s(&s2), s(&s1), "--out", s(&merged)]);
+    let reference = images(&a);
+    // tiny.toml ci: 2 families x 3 samples x 6 image files.
+    assert_eq!(reference.len(), 36, "{:?}", reference.keys());
+    assert!(reference == images(&b), "--jobs 2 differs from --jobs 1");
+    assert!(
+        reference == images(&merged),
+        "merged shards differ from the unsharded run"
+    );
+    assert_eq!(manifest_ids(&a), manifest_ids(&merged));
+    assert!(manifest_ids(&s1).len() == 3 && manifest_ids(&s2).len() == 3);
+}
+
+#[test]
+fn a_killed_run_resumes_to_a_complete_consistent_dataset() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = t.path().join("long.toml");
+    let text = std::fs::read_to_string(TINY).unwrap().replace(
+        "count = 3, width = 16, height = 16, spp = 2",
+        "count = 40, width = 16, height = 16, spp = 1",
+    );
+    std::fs::write(&suite, text).unwrap();
+    let out = t.path().join("data");
+    let mut child = bin()
+        .args([
+            "suite",
+            s(&suite),
+            "--out",
+            s(&out),
+            "--jobs",
+            "2",
+            "--quiet",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let manifest = out.join("manifest.jsonl");
+    while std::fs::read_to_string(&manifest).map_or(0, |m| m.lines().count()) < 3 {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no progress within 60 s"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let partial = std::fs::read_to_string(&manifest).unwrap().lines().count();
+    assert!(
+        partial < 80,
+        "the run finished before it was killed; the test needs more samples"
+    );
+    // No half-written sample: every committed-looking directory has all its files.
+    for e in std::fs::read_dir(&out).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if p.is_dir() && !name.starts_with('.') {
+            for f in [
+                "meta.json",
+                "raw.png",
+                "stokes.exr",
+                "gt/normal.exr",
+                "gt/depth.exr",
+                "gt/material.png",
+            ] {
+                assert!(p.join(f).is_file(), "{name}/{f} missing after the kill");
+            }
+        }
+    }
+    let rerun = run_ok(&[
+        "suite",
+        s(&suite),
+        "--out",
+        s(&out),
+        "--jobs",
+        "2",
+        "--quiet",
+    ]);
+    let table = String::from_utf8_lossy(&rerun.stdout);
+    assert!(table.contains("total"), "{table}");
+    // Complete and consistent: 80 entries, unique, each dir matching its checksums, nothing else.
+    let ids = manifest_ids(&out);
+    assert_eq!(ids.len(), 80);
+    let dirs: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        !dirs.iter().any(|d| d.starts_with('.')),
+        "staging left behind: {dirs:?}"
+    );
+    let mut sorted = dirs.clone();
+    sorted.sort();
+    assert_eq!(sorted, ids);
+    for line in std::fs::read_to_string(&manifest).unwrap().lines() {
+        let entry: polar_datagen::store::ManifestEntry = serde_json::from_str(line).unwrap();
+        polar_datagen::store::verify_entry(&out, &entry).unwrap();
+    }
+}
+
+#[test]
+fn merge_fails_naming_a_tampered_file_or_a_missing_shard() {
+    let t = tempfile::tempdir().unwrap();
+    let (s1, s2) = (t.path().join("s1"), t.path().join("s2"));
+    run_ok(&["suite", TINY, "--out", s(&s1), "--shard", "1/2", "--quiet"]);
+    run_ok(&["suite", TINY, "--out", s(&s2), "--shard", "2/2", "--quiet"]);
+    let missing = run(&["merge", s(&s1), "--out", s(&t.path().join("m0"))]);
+    assert!(!missing.status.success());
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("missing shard(s) 2/2"));
+    let id = &manifest_ids(&s2)[0];
+    let victim: PathBuf = s2.join(id).join("stokes.exr");
+    let mut bytes = std::fs::read(&victim).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x01;
+    std::fs::write(&victim, bytes).unwrap();
+    let merged = t.path().join("m1");
+    let out = run(&["merge", s(&s1), s(&s2), "--out", s(&merged)]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("checksum mismatch") && err.contains(s(&victim)),
+        "{err}"
+    );
+    assert!(
+        !merged.join("manifest.jsonl").exists(),
+        "a failed merge wrote a manifest"
+    );
+}
+
+#[test]
+fn bad_suite_files_and_outputs_fail_before_any_work() {
+    let t = tempfile::tempdir().unwrap();
+    let bad = t.path().join("bad.toml");
+    let text = std::fs::read_to_string(TINY).unwrap().replace(
+        "kind = \"shape\"",
+        "kind = \"shape\"\nranges = { ior = [0.5, 1.5] }",
+    );
+    std::fs::write(&bad, text).unwrap();
+    let out = t.path().join("never");
+    let r = run(&["suite", s(&bad), "--out", s(&out)]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        !r.status.success()
+            && err.contains("bad.toml")
+            && err.contains("ior")
+            && err.contains("[1, 3]"),
+        "{err}"
+    );
+    assert!(!out.exists(), "output created for a bad suite");
+
+    let file = t.path().join("a-file");
+    std::fs::write(&file, b"x").unwrap();
+    let r = run(&["suite", TINY, "--out", s(&file.join("sub"))]);
+    assert!(
+        String::from_utf8_lossy(&r.stderr).contains("not writable"),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+
+    let r = run(&["suite", TINY, "--out", s(&out), "--shard", "3/2"]);
+    assert!(!r.status.success() && String::from_utf8_lossy(&r.stderr).contains("K/N"));
+    assert!(!out.exists());
+}
+
+#[test]
+fn haze_family_is_reported_pending_and_demo_writes_a_sample_with_pictures() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = t.path().join("haze.toml");
+    let text = std::fs::read_to_string(TINY).unwrap()
+        + "\n[[family]]\nname = \"fog\"\nkind = \"haze\"\nci = { count = 2, width = 16, height = 16, spp = 1 }\nfull = { count = 2, width = 16, height = 16, spp = 1 }\n";
+    std::fs::write(&suite, text).unwrap();
+    let r = run_ok(&[
+        "suite",
+        s(&suite),
+        "--out",
+        s(&t.path().join("d")),
+        "--quiet",
+    ]);
+    let table = String::from_utf8_lossy(&r.stdout);
+    let fog = table
+        .lines()
+        .find(|l| l.starts_with("fog"))
+        .unwrap_or_default();
+    assert!(fog.contains("pending") && fog.contains("media"), "{table}");
+    assert!(String::from_utf8_lossy(&r.stderr).contains("participating-media"));
+    assert!(!t.path().join("d/fog-00000").exists());
+
+    let demo = t.path().join("demo");
+    run_ok(&["demo", "--out", s(&demo), "--size", "32", "--spp", "2"]);
+    for f in [
+        "meta.json",
+        "raw.png",
+        "stokes.exr",
+        "gt/normal.exr",
+        "pictures/aolp.png",
+        "pictures/dolp.png",
+        "pictures/s0.png",
+    ] {
+        assert!(demo.join(f).is_file(), "demo/{f}");
+    }
+}
