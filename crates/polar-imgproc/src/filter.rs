@@ -246,14 +246,21 @@ pub fn box_filter(
 #[inline(always)]
 fn row_box_sum(pad: &[f32], kw: usize, out: &mut [f64]) {
     let w = out.len();
-    if kw <= 9 {
-        out.iter_mut()
-            .zip(pad)
-            .for_each(|(o, &p)| *o = f64::from(p));
-        for i in 1..kw {
+    if kw <= 9 && kw % 2 == 1 {
+        // Three taps in the first pass, two in each further one (fewer stores).
+        let t = |i: usize| &pad[i..i + w];
+        let f = f64::from;
+        match kw {
+            1 => out.iter_mut().zip(t(0)).for_each(|(o, &a)| *o = f(a)),
+            _ => out
+                .iter_mut()
+                .zip(t(0).iter().zip(t(1).iter().zip(t(2))))
+                .for_each(|(o, (&a, (&b, &c)))| *o = f(a) + f(b) + f(c)),
+        }
+        for i in (3..kw).step_by(2) {
             out.iter_mut()
-                .zip(&pad[i..i + w])
-                .for_each(|(o, &p)| *o += f64::from(p));
+                .zip(t(i).iter().zip(t(i + 1)))
+                .for_each(|(o, (&a, &b))| *o += f(a) + f(b));
         }
         return;
     }
