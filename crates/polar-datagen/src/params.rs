@@ -364,10 +364,11 @@ pub fn draw_params(suite: &Suite, family: &Family, size: SizeName, index: u32) -
     } else {
         d.objects()
     };
-    // Keep every object in view: widen the distance with the row of objects.
+    // Keep every object in view: the row's half-extent plus 20 % margin within the half field.
     let extent: f64 = objects.iter().map(|o| 2.2 * o.size).sum();
+    let fit = 0.6 * extent / (0.5 * camera.fov_deg.to_radians()).tan();
     let camera = CameraParams {
-        distance: camera.distance.max(1.2 * extent),
+        distance: camera.distance.max(fit),
         ..camera
     };
     SampleParams {
@@ -415,6 +416,36 @@ mod tests {
                 };
                 assert!((1.4..1.6).contains(&ior), "ior {ior}");
                 assert!((0.0..0.35).contains(&roughness));
+            }
+        }
+    }
+
+    #[test]
+    fn every_drawn_shape_parameter_has_a_range_for_its_kind() {
+        // A key without a spec would silently draw 0 (e.g. a torus with no tube).
+        let text = include_str!("../../../datasets-synth/suites/standard.toml");
+        let s = Suite::parse(text).unwrap();
+        for f in s.families.iter().filter(|f| f.kind != FamilyKind::Haze) {
+            let keys: Vec<_> = crate::suite::param_specs(f.kind)
+                .iter()
+                .map(|p| p.key)
+                .collect();
+            for key in [
+                "superquadric_exponent",
+                "blob_amplitude",
+                "torus_minor_ratio",
+                "extrusion_sides",
+                "object_size",
+                "objects",
+            ] {
+                assert!(keys.contains(&key), "{} lacks {key}", f.name);
+            }
+            for i in 0..50 {
+                for o in draw_params(&s, f, SizeName::Ci, i).objects {
+                    if let ShapeParams::Torus { minor_ratio } = o.shape {
+                        assert!(minor_ratio >= 0.2, "{minor_ratio}");
+                    }
+                }
             }
         }
     }

@@ -271,6 +271,11 @@ const SHAPE: &[ParamSpec] = &[
         [0.0, 1.0],
         "diffuse albedo under the specular coat",
     ),
+    p("object_size", [0.5, 0.9], [0.05, 5.0], "object radius, m"),
+];
+
+/// Shape parameters, shared by every kind with objects.
+const GEOMETRY: &[ParamSpec] = &[
     p(
         "superquadric_exponent",
         [0.3, 1.9],
@@ -307,7 +312,6 @@ const SHAPE: &[ParamSpec] = &[
         [0.05, 4.0],
         "extrusion depth, fraction of size",
     ),
-    p("object_size", [0.5, 0.9], [0.05, 5.0], "object radius, m"),
 ];
 
 const MATERIAL: &[ParamSpec] = &[
@@ -389,15 +393,15 @@ const HAZE: &[ParamSpec] = &[
     ),
 ];
 
-/// The numeric parameters of a kind: common camera/light ones, then the kind's own.
+/// The numeric parameters of a kind: common camera/light ones, the kind's own, then shape ones.
 pub fn param_specs(kind: FamilyKind) -> Vec<ParamSpec> {
-    let own = match kind {
-        FamilyKind::Shape => SHAPE,
-        FamilyKind::Material => MATERIAL,
-        FamilyKind::Transparent => TRANSPARENT,
-        FamilyKind::Haze => HAZE,
+    let (own, geometry) = match kind {
+        FamilyKind::Shape => (SHAPE, GEOMETRY),
+        FamilyKind::Material => (MATERIAL, GEOMETRY),
+        FamilyKind::Transparent => (TRANSPARENT, GEOMETRY),
+        FamilyKind::Haze => (HAZE, &[][..]),
     };
-    COMMON.iter().chain(own).copied().collect()
+    COMMON.iter().chain(own).chain(geometry).copied().collect()
 }
 
 const SHAPES: &[&str] = &["sphere", "superquadric", "blob", "torus", "extrusion"];
