@@ -21,7 +21,7 @@ pub mod sensor;
 
 pub use demosaic::{DemosaicMethod, demosaic};
 pub use layout::{Mosaic, MosaicSample};
-pub use products::{StokesPlanes, stokes_planes};
+pub use products::{StokesPlanes, stokes_planes, stokes_planes_from_angles};
 pub use sensor::{SensorModel, SensorOutput};
 
 use thiserror::Error;
@@ -69,6 +69,21 @@ pub enum SensorError {
         value: f64,
         /// Valid range.
         reason: &'static str,
+    },
+    /// The polarizer angles do not determine linear Stokes (fewer than three distinct, NaN, ...).
+    #[error("least-squares Stokes: {0}")]
+    Fit(#[from] polar_optics::OpticsError),
+    /// Images of a multi-angle stack differ in size, or their number differs from the angles'.
+    #[error(
+        "{images} image(s) of sizes {sizes:?} for {angles} angle(s): need one image per angle, all of one size"
+    )]
+    StackShape {
+        /// Number of images.
+        images: usize,
+        /// Their sizes.
+        sizes: Vec<(usize, usize)>,
+        /// Number of angles.
+        angles: usize,
     },
     /// An input Stokes value is negative or not finite.
     #[error("Stokes image pixel ({x}, {y}) has a non-finite or negative S0 ({s0})")]

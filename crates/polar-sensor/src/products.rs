@@ -7,7 +7,8 @@
 //! `polar_optics::stokes`, and its `dolp`/`aolp` in the vectorisable form of [`crate::fastmath`].
 
 use polar_image::{Gray, LinearStokesImage, PolarizerStack};
-use polar_optics::stokes::linear_stokes_from_quad;
+use polar_optics::LinearStokesFit;
+use polar_optics::stokes::{imax, imin, linear_stokes_from_quad};
 use rayon::prelude::*;
 
 use crate::demosaic::bilinear::bilinear_stokes_row;
@@ -49,6 +50,27 @@ impl StokesPlanes {
     /// `(width, height)` of the planes.
     pub fn size(&self) -> (usize, usize) {
         self.s0.size()
+    }
+
+    /// Maximum intensity behind a rotating ideal polarizer, `(S0 + sqrt(S1² + S2²)) / 2`, per pixel.
+    pub fn imax(&self) -> Gray<f32> {
+        self.map3(imax)
+    }
+
+    /// Minimum intensity behind a rotating ideal polarizer, `(S0 − sqrt(S1² + S2²)) / 2`, per pixel.
+    pub fn imin(&self) -> Gray<f32> {
+        self.map3(imin)
+    }
+
+    /// `f(S0, S1, S2)` per pixel.
+    fn map3(&self, f: impl Fn(f32, f32, f32) -> f32 + Sync) -> Gray<f32> {
+        let mut out = Gray::new(self.s0.width(), self.s0.height());
+        let (a, b, c) = (self.s0.as_slice(), self.s1.as_slice(), self.s2.as_slice());
+        out.as_mut_slice()
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, v)| *v = f(a[k], b[k], c[k]));
+        out
     }
 
     /// `S0, S1, S2` as one interleaved 3-channel image.
@@ -115,6 +137,45 @@ fn derived_row(s0: &[f32], s1: &[f32], s2: &[f32], d: &mut [f32], a: &mut [f32])
     dolp_aolp_row(s0, s1, s2, d, a);
 }
 
+/// Least-squares `S0, S1, S2, DoLP, AoLP` from images behind ideal polarizers at any
+/// `angles` (radians; at least three distinct modulo π), e.g. a rotating-polarizer
+/// sequence. The fit is `polar_optics::LinearStokesFit` (pseudo-inverse computed once,
+/// applied per pixel in f32); for 0/45/90/135° it equals the four-image formula.
+pub fn stokes_planes_from_angles(
+    images: &[&Gray<f32>],
+    angles: &[f64],
+) -> Result<StokesPlanes, SensorError> {
+    let fit = LinearStokesFit::new(angles)?;
+    let sizes: Vec<(usize, usize)> = images.iter().map(|i| i.size()).collect();
+    if images.len() != angles.len() || sizes.windows(2).any(|p| p[0] != p[1]) {
+        return Err(SensorError::StackShape {
+            images: images.len(),
+            sizes,
+            angles: angles.len(),
+        });
+    }
+    let pinv = fit.pseudo_inverse();
+    let weights: Vec<[f32; 3]> = (0..angles.len())
+        .map(|i| std::array::from_fn(|j| pinv[(j, i)] as f32))
+        .collect();
+    let (w, h) = sizes[0];
+    let mut out = StokesPlanes::new(w, h);
+    out.rows_mut()
+        .enumerate()
+        .for_each(|(y, [s0, s1, s2, d, a])| {
+            for x in 0..w {
+                let mut s = [0.0f32; 3];
+                for (img, wt) in images.iter().zip(&weights) {
+                    let v = img.as_slice()[y * w + x];
+                    s.iter_mut().zip(wt).for_each(|(s, wt)| *s += wt * v);
+                }
+                [s0[x], s1[x], s2[x]] = s;
+            }
+            derived_row(s0, s1, s2, d, a);
+        });
+    Ok(out)
+}
+
 /// Raw mosaic -> `S0, S1, S2, DoLP, AoLP`, allocating the output.
 pub fn stokes_planes<T: MosaicSample>(
     raw: &Mosaic<T>,
@@ -163,6 +224,7 @@ pub fn stokes_planes_into<T: MosaicSample>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use polar_optics::stokes::intensity_through_polarizer;
 
     fn test_mosaic(w: usize, h: usize) -> Mosaic<u8> {
         Mosaic::from_vec(
@@ -189,6 +251,62 @@ mod tests {
             assert_eq!(fused.s2, two_step.s2);
             assert_eq!(fused.dolp, two_step.dolp);
             assert_eq!(fused.aolp, two_step.aolp);
+        }
+    }
+
+    /// Five angles, 0..144° in 36° steps, images made by Malus's law: the fit recovers
+    /// the Stokes vector to f32 rounding (1e-4 relative), and a 3-angle set is enough.
+    #[test]
+    fn least_squares_from_arbitrary_angles() {
+        let truth = [10.0f32, 3.0, -4.0];
+        for angles_deg in [vec![0.0, 36.0, 72.0, 108.0, 144.0], vec![10.0, 70.0, 130.0]] {
+            let angles: Vec<f64> = angles_deg.iter().map(|a: &f64| a.to_radians()).collect();
+            let images: Vec<Gray<f32>> = angles
+                .iter()
+                .map(|&t| {
+                    let v = intensity_through_polarizer(truth[0], truth[1], truth[2], t as f32);
+                    Gray::from_vec(3, 2, vec![v; 6]).unwrap()
+                })
+                .collect();
+            let refs: Vec<&Gray<f32>> = images.iter().collect();
+            let p = stokes_planes_from_angles(&refs, &angles).unwrap();
+            for (plane, want) in [(&p.s0, truth[0]), (&p.s1, truth[1]), (&p.s2, truth[2])] {
+                assert!(
+                    plane
+                        .as_slice()
+                        .iter()
+                        .all(|v| (v - want).abs() < 1e-4 * 10.0),
+                    "{angles_deg:?}"
+                );
+            }
+            assert!((p.dolp.as_slice()[0] - 0.5).abs() < 1e-5);
+        }
+        let one = Gray::<f32>::new(2, 2);
+        let err = stokes_planes_from_angles(&[&one, &one], &[0.0, 1.0]).unwrap_err();
+        assert!(matches!(err, SensorError::Fit(_)), "{err}");
+        let other = Gray::<f32>::new(4, 2);
+        let err = stokes_planes_from_angles(&[&one, &one, &other], &[0.0, 1.0, 2.0]).unwrap_err();
+        assert!(
+            matches!(err, SensorError::StackShape { images: 3, .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn imax_imin_bracket_the_polarizer_images() {
+        let raw = test_mosaic(8, 8);
+        let stack = demosaic(&raw, DemosaicMethod::Superpixel).unwrap();
+        let p = StokesPlanes::from_stack(&stack);
+        let (hi, lo) = (p.imax(), p.imin());
+        for (k, px) in stack.pixels().iter().enumerate() {
+            // Four-image Stokes fits I(θ) exactly only if I0 + I90 = I45 + I135; allow that residual.
+            let slack = 0.5 * ((px[0] + px[2]) - (px[1] + px[3])).abs() + 1e-3;
+            assert!(
+                px.iter()
+                    .all(|&i| i <= hi.as_slice()[k] + slack && i >= lo.as_slice()[k] - slack),
+                "{k}"
+            );
+            assert!((hi.as_slice()[k] + lo.as_slice()[k] - p.s0.as_slice()[k]).abs() < 1e-3);
         }
     }
 
