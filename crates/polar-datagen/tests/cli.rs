@@ -284,3 +284,95 @@ fn haze_family_is_reported_pending_and_demo_writes_a_sample_with_pictures() {
         assert!(demo.join(f).is_file(), "demo/{f}");
     }
 }
+
+const SCENE: &str = r#"
+version = 1
+[render]
+spp = 4
+seed = 1
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov_deg = 30.0
+width = 16
+height = 16
+[materials.sphere]
+type = "plastic"
+albedo = 0.5
+ior = 1.5
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "sphere"
+[[lights]]
+type = "environment"
+radiance = 0.5
+[sensor]
+bits = 10
+read_noise_e = 3.0
+"#;
+
+#[test]
+fn render_is_seeded_and_rejects_bad_scene_files_before_rendering() {
+    let t = tempfile::tempdir().unwrap();
+    let scene = t.path().join("scene.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let (a, b, c) = (t.path().join("a"), t.path().join("b"), t.path().join("c"));
+    run_ok(&[
+        "render",
+        s(&scene),
+        "--out",
+        s(&a),
+        "--spp",
+        "2",
+        "--seed",
+        "3",
+    ]);
+    run_ok(&[
+        "render",
+        s(&scene),
+        "--out",
+        s(&b),
+        "--spp",
+        "2",
+        "--seed",
+        "3",
+    ]);
+    run_ok(&[
+        "render",
+        s(&scene),
+        "--out",
+        s(&c),
+        "--spp",
+        "2",
+        "--seed",
+        "4",
+    ]);
+    let raw = |d: &Path| std::fs::read(d.join("raw.png")).unwrap();
+    assert_eq!(raw(&a), raw(&b), "same seed, different raw.png");
+    assert_ne!(raw(&a), raw(&c), "the seed does not reach the noise");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(a.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["sensor"]["bit_depth"], 10);
+    assert_eq!(meta["spp"], 2);
+
+    let bad = t.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        SCENE.replace("radius = 1.0", "radius = 1.0\ncolour = 2"),
+    )
+    .unwrap();
+    let out = t.path().join("never");
+    let r = run(&["render", s(&bad), "--out", s(&out)]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        !r.status.success() && err.contains("bad.toml") && err.contains("colour"),
+        "{err}"
+    );
+    std::fs::write(&bad, SCENE.replace("bits = 10", "bitz = 10")).unwrap();
+    let r = run(&["render", s(&bad), "--out", s(&out)]);
+    assert!(String::from_utf8_lossy(&r.stderr).contains("bitz"));
+    assert!(!out.exists(), "output created for a bad scene");
+}

@@ -1,0 +1,110 @@
+//! The dataset machinery with a stand-in worker (no renderer): failures, resume and
+//! checksum verification of committed samples.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use polar_datagen::Error;
+use polar_datagen::params::SampleParams;
+use polar_datagen::progress::Progress;
+use polar_datagen::run::{RunOptions, SampleWorker, Shard, WorkReport, prepare_output, run_suite};
+use polar_datagen::store::{read_manifest, verify_entry};
+use polar_datagen::suite::{SizeName, Suite};
+
+const SUITE: &str = include_str!("../../../datasets-synth/suites/tiny.toml");
+
+/// Writes the seed as bytes; fails on one id when asked; counts calls.
+struct Fake {
+    fail_on: Option<&'static str>,
+    calls: AtomicUsize,
+}
+
+impl SampleWorker for Fake {
+    fn produce(&self, p: &SampleParams, dir: &Path) -> Result<WorkReport, Error> {
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        if self.fail_on == Some(p.id.as_str()) {
+            return Err(Error::Sample {
+                id: p.id.clone(),
+                message: "injected failure".into(),
+            });
+        }
+        std::fs::create_dir_all(dir.join("gt")).unwrap();
+        std::fs::write(dir.join("raw.png"), p.seed.to_le_bytes()).unwrap();
+        std::fs::write(dir.join("gt/depth.exr"), p.index.to_le_bytes()).unwrap();
+        Ok(WorkReport {
+            model: "Fake".into(),
+            render_seconds: 0.0,
+        })
+    }
+}
+
+fn options(out: &Path) -> RunOptions {
+    RunOptions {
+        out: out.to_owned(),
+        size: SizeName::Ci,
+        shard: Shard::ALL,
+        jobs: 1,
+        progress: Progress::Quiet,
+    }
+}
+
+#[test]
+fn a_failed_run_keeps_its_committed_samples_and_resume_remakes_only_the_rest() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = Suite::parse(SUITE).unwrap();
+    let opts = options(t.path());
+    prepare_output(&suite, SUITE, &opts).unwrap();
+    // jobs = 1 runs in plan order: sfp-00000..2, then glass-00000..2.
+    let failing = Fake {
+        fail_on: Some("glass-00001"),
+        calls: AtomicUsize::new(0),
+    };
+    let err = run_suite(&suite, &opts, &failing).unwrap_err().to_string();
+    assert!(
+        err.contains("glass-00001") && err.contains("injected"),
+        "{err}"
+    );
+    let committed = read_manifest(t.path()).unwrap();
+    assert_eq!(committed.len(), 4);
+    for e in &committed {
+        verify_entry(t.path(), e).unwrap();
+    }
+    assert!(!t.path().join("glass-00001").exists());
+
+    // Corrupt one committed sample: resume must notice the checksum and make it again.
+    std::fs::write(t.path().join("sfp-00000/raw.png"), b"tampered").unwrap();
+    let good = Fake {
+        fail_on: None,
+        calls: AtomicUsize::new(0),
+    };
+    let summary = run_suite(&suite, &opts, &good).unwrap();
+    assert_eq!(
+        good.calls.load(Ordering::Relaxed),
+        3,
+        "glass-00001, glass-00002 and the tampered sfp-00000"
+    );
+    assert_eq!(summary.families["sfp"].resumed, 2);
+    assert_eq!(summary.families["glass"].made, 2);
+    let all = read_manifest(t.path()).unwrap();
+    assert_eq!(all.len(), 6);
+    for e in &all {
+        verify_entry(t.path(), e).unwrap();
+    }
+    assert!(summary.table().contains("Fake"));
+}
+
+#[test]
+fn a_directory_of_another_run_is_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = Suite::parse(SUITE).unwrap();
+    prepare_output(&suite, SUITE, &options(t.path())).unwrap();
+    let other = SUITE.replace("seed = 7", "seed = 8");
+    let err =
+        prepare_output(&Suite::parse(&other).unwrap(), &other, &options(t.path())).unwrap_err();
+    assert!(err.to_string().contains("different run"), "{err}");
+    let sharded = RunOptions {
+        shard: Shard { k: 1, n: 2 },
+        ..options(t.path())
+    };
+    assert!(prepare_output(&suite, SUITE, &sharded).is_err());
+}
