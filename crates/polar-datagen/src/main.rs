@@ -17,6 +17,9 @@ use polar_datagen::{Error, merge, store};
 /// stokes.exr (S0..S3) and gt/ (normal.exr, depth.exr, material.png, transparent.png), as in
 /// the project's conventions. Images are deterministic: the same suite and seed give
 /// byte-identical images whatever --jobs or --shard.
+///
+/// Suite format: datasets-synth/suites/README.md. Clusters (Slurm job array, Kubernetes
+/// Indexed Job): tools/datagen-cluster.md.
 #[derive(Parser, Debug)]
 #[command(name = "polar-datagen", version, about, long_about)]
 struct Cli {
