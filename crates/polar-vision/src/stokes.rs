@@ -27,8 +27,10 @@ pub struct StokesArgs {
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Demosaicing method: superpixel (half resolution), bilinear (= polanalyser
-    /// COLOR_PolarMono, bit-exact), newton (Li et al. 2019, the most accurate).
+    /// Demosaicing method: superpixel (half resolution, no interpolation), bilinear
+    /// (= polanalyser COLOR_PolarMono, bit-exact; fastest full-resolution method),
+    /// newton (Newton-polynomial, Li et al. 2019: better on fine texture, worse at
+    /// polarization edges; see the demosaic_error example of polar-sensor).
     #[arg(long, value_name = "NAME", default_value = "bilinear", value_parser = parse_method)]
     pub demosaic: DemosaicMethod,
     /// Significant bits of the sensor data (8, 10, 12 or 16). Default: the PNG's

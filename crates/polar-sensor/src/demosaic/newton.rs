@@ -17,6 +17,11 @@
 //! Pixels within 3 of the border, where the 7-tap stencil does not fit, keep the
 //! bilinear values; within 5 of the border the classifier is skipped (weights only).
 //! Results are clamped at 0 (intensities cannot be negative).
+//!
+//! Measured (example `demosaic_error`): on fine texture up to the Nyquist
+//! frequency it gains 0.6–1.5 dB PSNR over bilinear on three of the four channels
+//! and lowers the AoLP error; at edges where the *polarization* changes, the
+//! polarization-difference assumption fails and it is worse than bilinear.
 
 use polar_image::PolarizerStack;
 use rayon::prelude::*;
