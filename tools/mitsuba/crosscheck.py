@@ -34,7 +34,7 @@ def parse_args():
     ap.add_argument("out", type=Path, help="output dir: comparison PNGs and our renders")
     ap.add_argument("--refs", type=Path, default=None, help="Mitsuba reference cache (default: a temporary dir)")
     ap.add_argument("--ours", type=Path, default=None, help="use OURS/<scene>/stokes.exr instead of running our renderer")
-    ap.add_argument("--spp-ours", type=int, default=None, help="--spp passed to our renderer (default: the scene file's)")
+    ap.add_argument("--spp-ours", type=int, default=None, help=f"--spp for our renderer, all scenes (default per scene: {scenes.OURS_SPP})")
     ap.add_argument("--scenes", type=render_refs.parse_scene_list, default=scenes.SCENES)
     ap.add_argument("--threads", type=int, default=None, help="threads for both renderers (default: all cores)")
     ap.add_argument("--ours-only-if-available", action="store_true",
@@ -57,7 +57,7 @@ def our_stokes_source(args):
     print(f"our renderer: {exe}")
 
     def run(name):
-        stokes, seconds, source = ours.render(exe, name, args.out / "ours" / name, args.spp_ours, args.threads)
+        stokes, seconds, source = ours.render(exe, name, args.out / "ours" / name, args.spp_ours or scenes.OURS_SPP[name], args.threads)
         print(f"{name}: our render took {seconds:.2f} s ({source})")
         return stokes
 
