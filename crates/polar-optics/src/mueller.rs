@@ -15,6 +15,7 @@ pub type Mueller = Matrix4<f64>;
 pub type LinearMueller = Matrix3<f64>;
 
 /// The upper-left 3×3 block of `m` (rows and columns S0, S1, S2).
+#[inline]
 pub fn linear_part(m: &Mueller) -> LinearMueller {
     m.fixed_view::<3, 3>(0, 0).into_owned()
 }
@@ -26,6 +27,7 @@ pub fn couples_circular(m: &Mueller, tol: f64) -> bool {
 }
 
 /// The 3×3 form of [`rotator`]: `[[1,0,0],[0,cos2θ,sin2θ],[0,−sin2θ,cos2θ]]`.
+#[inline]
 pub fn linear_rotator(theta: f64) -> LinearMueller {
     linear_part(&rotator(theta))
 }
@@ -34,6 +36,7 @@ pub fn linear_rotator(theta: f64) -> LinearMueller {
 /// light polarized at `α` in the old frame is at `α − θ` in the new one.
 ///
 /// `R(θ) = [[1,0,0,0],[0,cos2θ,sin2θ,0],[0,−sin2θ,cos2θ,0],[0,0,0,1]]`.
+#[inline]
 pub fn rotator(theta: f64) -> Mueller {
     let (s, c) = (2.0 * theta).sin_cos();
     #[rustfmt::skip]
@@ -48,6 +51,7 @@ pub fn rotator(theta: f64) -> Mueller {
 
 /// The element `m` physically rotated by `theta` about the propagation axis:
 /// `R(−θ) · M · R(θ)`.
+#[inline]
 pub fn rotated_element(m: &Mueller, theta: f64) -> Mueller {
     rotator(-theta) * m * rotator(theta)
 }
@@ -71,6 +75,7 @@ pub fn linear_polarizer(theta: f64) -> Mueller {
 /// `M = [[A, B, 0, 0], [B, A, 0, 0], [0, 0, Re w, −Im w], [0, 0, Im w, Re w]]`,
 /// `A = (|a_x|² + |a_y|²)/2`, `B = (|a_x|² − |a_y|²)/2`; the sign of the lower block
 /// follows from `S3 = I_RCP − I_LCP` under `exp(−iωt)`.
+#[inline]
 pub fn from_diagonal_jones(a_x: Complex64, a_y: Complex64) -> Mueller {
     crate::block::BlockDiagonal::from_diagonal_jones(a_x, a_y).to_mueller()
 }
