@@ -14,7 +14,9 @@ mod sample;
 mod validate;
 
 pub use error::{Error, Result};
-pub use openexr::{exr_channel_names, read_exr, read_exr_channel, write_exr};
+pub use openexr::{
+    ExrCompression, exr_channel_names, read_exr, read_exr_channel, write_exr, write_exr_with,
+};
 pub use png::{
     BitDepth, GrayPng, check_mosaic_size, read_gray_png, read_gray8_png, read_mosaic,
     read_rgb8_png, write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png,

@@ -1,24 +1,64 @@
 //! Float OpenEXR images with named channels (S0..S3; R, G, B; Y), through the `exr` crate.
-//! Files are written single-layer, float32, ZIP-compressed scanlines; any single-layer file
-//! (scanline or tiled, f16/f32/u32 samples) is readable.
+//! Files are written single-layer, float32 scanlines (ZIP per line by default); any
+//! single-layer file (scanline or tiled, any compression, f16/f32/u32 samples) is readable.
 
 use std::path::Path;
 
 use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, MetaData, ReadChannels,
-    ReadLayers, Text, WritableImage, read,
+    AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Layer, LayerAttributes,
+    LineOrder, MetaData, ReadChannels, ReadLayers, Text, WritableImage, read,
 };
 use polar_image::{Gray, Image};
 
 use crate::atomic::write_file_atomic;
 use crate::error::{Error, Result};
 
+/// Lossless compression of written EXR files. Measured on a 2448x2048 4-channel noisy float
+/// image (`benches/io.rs` and a one-off comparison, 2 loaded cores): none 0.1 s / 80 MB,
+/// RLE 0.3 s / 80 MB, ZIP per line 1.4 s / 75 MB, ZIP per 16 lines 4.8 s / 72 MB.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ExrCompression {
+    /// Raw samples: fastest, largest.
+    None,
+    /// Run-length: nearly free, shrinks only constant runs (backgrounds, masks).
+    Rle,
+    /// Deflate per scanline (OpenEXR `ZIPS`): also shrinks smooth data; the default.
+    #[default]
+    Zip,
+}
+
+impl ExrCompression {
+    fn encoding(self) -> Encoding {
+        let compression = match self {
+            ExrCompression::None => Compression::Uncompressed,
+            ExrCompression::Rle => Compression::RLE,
+            ExrCompression::Zip => Compression::ZIP1,
+        };
+        Encoding {
+            compression,
+            blocks: Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        }
+    }
+}
+
 /// Writes `image` as a single-layer float32 EXR whose channel `c` is named `names[c]`,
-/// atomically. Names must be non-empty, distinct and Latin-1 (an EXR rule).
+/// atomically, with the default [`ExrCompression`]. Names must be non-empty, distinct and
+/// Latin-1 (an EXR rule).
 pub fn write_exr<const C: usize>(
     path: impl AsRef<Path>,
     image: &Image<f32, C>,
     names: [&str; C],
+) -> Result<()> {
+    write_exr_with(path, image, names, ExrCompression::default())
+}
+
+/// [`write_exr`] with a chosen compression.
+pub fn write_exr_with<const C: usize>(
+    path: impl AsRef<Path>,
+    image: &Image<f32, C>,
+    names: [&str; C],
+    compression: ExrCompression,
 ) -> Result<()> {
     let path = path.as_ref();
     let texts = channel_texts(path, &names)?;
@@ -41,7 +81,7 @@ pub fn write_exr<const C: usize>(
     let layer = Layer::new(
         (width, height),
         LayerAttributes::default(),
-        Encoding::SMALL_LOSSLESS,
+        compression.encoding(),
         AnyChannels::sort(channels.into()),
     );
     let exr_image = exr::prelude::Image::from_layer(layer);

@@ -8,8 +8,8 @@ use exr::prelude::{
 };
 use polar_image::{Image, StokesImage};
 use polar_io::{
-    Error, Rule, STOKES_CHANNELS, check_channels, check_stokes, exr_channel_names, read_exr,
-    read_exr_channel, write_exr,
+    Error, ExrCompression, Rule, STOKES_CHANNELS, check_channels, check_stokes, exr_channel_names,
+    read_exr, read_exr_channel, write_exr, write_exr_with,
 };
 
 /// A 4-channel image holding awkward floats: negative, subnormal, huge, signed zero.
@@ -76,6 +76,25 @@ fn stokes_round_trip_is_bit_exact() {
     assert_eq!(back.size(), (37, 21));
     assert_eq!(bits(&back), bits(&img));
     assert_eq!(exr_channel_names(&path).unwrap(), ["S0", "S1", "S2", "S3"]);
+}
+
+#[test]
+fn every_compression_round_trips_bit_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let img = awkward_stokes(19, 23);
+    for c in [
+        ExrCompression::None,
+        ExrCompression::Rle,
+        ExrCompression::Zip,
+    ] {
+        let path = dir.path().join(format!("{c:?}.exr"));
+        write_exr_with(&path, &img, STOKES_CHANNELS, c).unwrap();
+        assert_eq!(
+            bits(&read_exr(&path, STOKES_CHANNELS).unwrap()),
+            bits(&img),
+            "{c:?}"
+        );
+    }
 }
 
 #[test]
