@@ -10,44 +10,10 @@
 //! Everything is vectorised over a row of pixels. Large `u8` windows use a sliding
 //! histogram (Huang et al. 1979).
 
-use std::sync::OnceLock;
-
 use polar_image::Gray;
 use rayon::prelude::*;
 
 use crate::{Border, Error, filter::band_rows, same_size};
-
-/// Batcher's odd-even merge sort for `n` values, with the wires beyond `n` (padding to a
-/// power of two) holding +inf folded away: comparators as slot pairs, and the slot that
-/// ends at each sorted position.
-fn batcher(n: usize) -> SortNetwork {
-    let size = n.next_power_of_two();
-    let mut wire: Vec<Option<usize>> = (0..size).map(|i| (i < n).then_some(i)).collect();
-    let mut ops = Vec::new();
-    let mut p = 1;
-    while p < size {
-        let mut k = p;
-        while k >= 1 {
-            let mut j = k % p;
-            while j + k < size {
-                for i in
-                    (0..k.min(size - j - k)).filter(|i| (i + j) / (2 * p) == (i + j + k) / (2 * p))
-                {
-                    let (a, b) = (i + j, i + j + k);
-                    match (wire[a], wire[b]) {
-                        (Some(sa), Some(sb)) => ops.push((sa, sb)),
-                        (None, Some(_)) => wire.swap(a, b),
-                        _ => {}
-                    }
-                }
-                j += 2 * k;
-            }
-            k /= 2;
-        }
-        p *= 2;
-    }
-    (ops, wire.into_iter().flatten().collect())
-}
 
 /// A pixel type the median network can order.
 trait Lane: Copy + Default + Send + Sync + PartialOrd {}
@@ -62,32 +28,6 @@ fn lo<T: Lane>(a: T, b: T) -> T {
 #[inline(always)]
 fn hi<T: Lane>(a: T, b: T) -> T {
     if b < a { a } else { b }
-}
-
-/// Two distinct slots of length `len` of a flat buffer, mutably.
-#[inline(always)]
-fn two_slots<T>(buf: &mut [T], len: usize, a: usize, b: usize) -> (&mut [T], &mut [T]) {
-    if a < b {
-        let (x, y) = buf.split_at_mut(b * len);
-        (&mut x[a * len..(a + 1) * len], &mut y[..len])
-    } else {
-        let (x, y) = buf.split_at_mut(a * len);
-        (&mut y[..len], &mut x[b * len..(b + 1) * len])
-    }
-}
-
-/// Sorts, at every position, the values of the slots of length `len` stored back to back
-/// in `buf` with a network of compare-exchanges `(a, b)` (`a` gets the smaller value).
-#[inline(always)]
-fn sort_slots<T: Lane>(exchanges: &[(usize, usize)], buf: &mut [T], len: usize) {
-    for &(a, b) in exchanges {
-        let (sa, sb) = two_slots(buf, len, a, b);
-        sa.iter_mut().zip(sb.iter_mut()).for_each(|(x, y)| {
-            let (l, h) = (lo(*x, *y), hi(*x, *y));
-            *x = l;
-            *y = h;
-        });
-    }
 }
 
 /// Writes a comparator network out as straight-line code (so that the compiler keeps the
@@ -128,13 +68,23 @@ straight_network!(median25_sorted_columns, MEDIAN25_STEPS, 25;
     lo 12 16, lo 13 17, hi 10 12, lo 11 13, hi 11 12
 );
 
-/// A sorting network: compare-exchanges, and the slot holding each rank afterwards.
-type SortNetwork = (Vec<(usize, usize)>, Vec<usize>);
+// Batcher's network sorting 5 values (the tests' `batcher(5)`, ranks end in slot order).
+straight_network!(sort5, SORT5_STEPS, 5; x 0 1, x 2 3, x 0 2, x 1 3, x 1 2, x 0 4, x 2 4, x 1 2, x 3 4);
 
-/// Column-sorting network for `ksize` values.
-fn column_network(ksize: usize) -> &'static SortNetwork {
-    static N: [OnceLock<SortNetwork>; 2] = [OnceLock::new(), OnceLock::new()];
-    N[usize::from(ksize == 5)].get_or_init(|| batcher(ksize))
+/// Sorts the columns of five consecutive rows (`rows`, back to back) into `cols`, rank by
+/// rank, in one pass.
+fn sort5_columns<T: Lane>(rows: &[T], cols: &mut [T]) {
+    let pw = rows.len() / 5;
+    let r: [&[T]; 5] = std::array::from_fn(|j| &rows[j * pw..(j + 1) * pw]);
+    let (c0, rest) = cols.split_at_mut(pw);
+    let (c1, rest) = rest.split_at_mut(pw);
+    let (c2, rest) = rest.split_at_mut(pw);
+    let (c3, c4) = rest.split_at_mut(pw);
+    for x in 0..pw {
+        let mut v = [r[0][x], r[1][x], r[2][x], r[3][x], r[4][x]];
+        sort5(&mut v);
+        (c0[x], c1[x], c2[x], c3[x], c4[x]) = (v[0], v[1], v[2], v[3], v[4]);
+    }
 }
 
 /// Median for `ksize` 3 or 5, replicate border: each output row first sorts every column
@@ -142,7 +92,6 @@ fn column_network(ksize: usize) -> &'static SortNetwork {
 fn median_small<T: Lane>(src: &Gray<T>, dst: &mut Gray<T>, ksize: usize) {
     let (w, h) = src.size();
     let r = ksize / 2;
-    let (column, order) = column_network(ksize);
     let rows = band_rows(r);
     let s = src.as_slice();
     let pw = w + 2 * r;
@@ -162,13 +111,12 @@ fn median_small<T: Lane>(src: &Gray<T>, dst: &mut Gray<T>, ksize: usize) {
             for (row, orow) in out.chunks_exact_mut(w).enumerate() {
                 if ksize == 3 {
                     sort3_columns(&padded[row * pw..(row + 3) * pw], cols);
-                    median3_of_sorted_columns(cols, pw, &[0, 1, 2], orow);
+                    median3_of_sorted_columns(cols, pw, orow);
                     continue;
                 }
-                cols.copy_from_slice(&padded[row * pw..(row + ksize) * pw]);
-                sort_slots(column, cols, pw);
+                sort5_columns(&padded[row * pw..(row + 5) * pw], cols);
                 let taps: [&[T]; 25] = std::array::from_fn(|i| {
-                    let start = order[i % 5] * pw + i / 5;
+                    let start = (i % 5) * pw + i / 5;
                     &cols[start..start + w]
                 });
                 for (x, o) in orow.iter_mut().enumerate() {
@@ -185,9 +133,9 @@ fn median_small<T: Lane>(src: &Gray<T>, dst: &mut Gray<T>, ksize: usize) {
 /// `med3(max(lo), med3(mid), min(hi))` over three neighbouring columns, a classic
 /// identity (e.g. Paeth, Graphics Gems 1990) that needs no copies.
 #[inline(always)]
-fn median3_of_sorted_columns<T: Lane>(cols: &[T], pw: usize, order: &[usize], out: &mut [T]) {
+fn median3_of_sorted_columns<T: Lane>(cols: &[T], pw: usize, out: &mut [T]) {
     let w = out.len();
-    let row = |rank: usize, dx: usize| &cols[order[rank] * pw + dx..order[rank] * pw + dx + w];
+    let row = |rank: usize, dx: usize| &cols[rank * pw + dx..rank * pw + dx + w];
     let med3 = |a: T, b: T, c: T| hi(lo(a, b), lo(hi(a, b), c));
     let (l0, l1, l2) = (row(0, 0), row(0, 1), row(0, 2));
     let (m0, m1, m2) = (row(1, 0), row(1, 1), row(1, 2));
@@ -316,6 +264,50 @@ pub fn median_blur_u8(src: &Gray<u8>, dst: &mut Gray<u8>, ksize: usize) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two distinct slots of length `len` of a flat buffer, mutably.
+    #[inline(always)]
+    fn two_slots<T>(buf: &mut [T], len: usize, a: usize, b: usize) -> (&mut [T], &mut [T]) {
+        if a < b {
+            let (x, y) = buf.split_at_mut(b * len);
+            (&mut x[a * len..(a + 1) * len], &mut y[..len])
+        } else {
+            let (x, y) = buf.split_at_mut(a * len);
+            (&mut y[..len], &mut x[b * len..(b + 1) * len])
+        }
+    }
+
+    /// Batcher's odd-even merge sort for `n` values, with the wires beyond `n` (padding to a
+    /// power of two) holding +inf folded away: comparators as slot pairs, and the slot that
+    /// ends at each sorted position.
+    fn batcher(n: usize) -> (Vec<(usize, usize)>, Vec<usize>) {
+        let size = n.next_power_of_two();
+        let mut wire: Vec<Option<usize>> = (0..size).map(|i| (i < n).then_some(i)).collect();
+        let mut ops = Vec::new();
+        let mut p = 1;
+        while p < size {
+            let mut k = p;
+            while k >= 1 {
+                let mut j = k % p;
+                while j + k < size {
+                    for i in (0..k.min(size - j - k))
+                        .filter(|i| (i + j) / (2 * p) == (i + j + k) / (2 * p))
+                    {
+                        let (a, b) = (i + j, i + j + k);
+                        match (wire[a], wire[b]) {
+                            (Some(sa), Some(sb)) => ops.push((sa, sb)),
+                            (None, Some(_)) => wire.swap(a, b),
+                            _ => {}
+                        }
+                    }
+                    j += 2 * k;
+                }
+                k /= 2;
+            }
+            p *= 2;
+        }
+        (ops, wire.into_iter().flatten().collect())
+    }
 
     /// One step of a comparator network on value slots (`a` gets the smaller value).
     #[derive(Clone, Copy, Debug)]
@@ -447,6 +439,9 @@ mod tests {
             .collect();
         assert_eq!(generated, MEDIAN25_STEPS);
         assert_eq!(out, 12);
+        let (sort, order) = batcher(5);
+        let sort: Vec<(&str, usize, usize)> = sort.into_iter().map(|(a, b)| ("x", a, b)).collect();
+        assert_eq!((sort.as_slice(), order), (SORT5_STEPS, vec![0, 1, 2, 3, 4]));
     }
 
     #[test]
