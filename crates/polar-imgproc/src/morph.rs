@@ -143,19 +143,21 @@ fn morph<P: Pick>(
                     }
                     continue;
                 };
-                cur[..ax].fill(neutral);
-                cur[ax + w..].fill(neutral);
-                cur[ax..ax + w].copy_from_slice(&s[y * w..(y + 1) * w]);
-                if distinct.len() == 1 && max_len <= DIRECT_MAX {
-                    for (d, &(x0, len)) in distinct.iter().enumerate() {
-                        let taps: Vec<&[f32]> = (x0..x0 + len).map(|i| &cur[i..i + w]).collect();
-                        pick_into::<P>(
-                            &mut tmp[(d * n_tmp + t) * w..(d * n_tmp + t + 1) * w],
-                            &taps,
-                        );
-                    }
+                let row = &s[y * w..(y + 1) * w];
+                if let [(x0, len)] = distinct[..]
+                    && max_len <= DIRECT_MAX
+                {
+                    run_direct::<P>(
+                        row,
+                        x0 as isize - ax as isize,
+                        len,
+                        &mut tmp[t * w..(t + 1) * w],
+                    );
                     continue;
                 }
+                cur[..ax].fill(neutral);
+                cur[ax + w..].fill(neutral);
+                cur[ax..ax + w].copy_from_slice(row);
                 // Doubling: at level `span`, cur[x] = extremum of the `span` pixels from x; a
                 // run of length len is two overlapping windows of the largest span <= len.
                 let mut span = 1;
@@ -235,6 +237,28 @@ fn pick_into<P: Pick>(out: &mut [f32], taps: &[&[f32]]) {
                 .for_each(|(o, (&a, (&b, &c)))| *o = P::pick(P::pick(*o, a), P::pick(b, c))),
             _ => {}
         }
+    }
+}
+
+/// `out[x] = extremum of row[x + off .. x + off + len]` (columns outside the row ignored),
+/// straight from the source row: taps fused by [`pick_into`] inside, a scalar loop on the
+/// few edge pixels.
+fn run_direct<P: Pick>(row: &[f32], off: isize, len: usize, out: &mut [f32]) {
+    let w = row.len() as isize;
+    let lo = (-off).clamp(0, w);
+    let hi = (w - off - len as isize + 1).clamp(lo, w);
+    let (lo, hi) = (lo as usize, hi as usize);
+    if hi > lo {
+        let base = (lo as isize + off) as usize;
+        let taps: Vec<&[f32]> = (0..len)
+            .map(|i| &row[base + i..base + i + hi - lo])
+            .collect();
+        pick_into::<P>(&mut out[lo..hi], &taps);
+    }
+    for x in (0..lo).chain(hi..row.len()) {
+        let first = (x as isize + off).max(0);
+        let last = (x as isize + off + len as isize).min(w);
+        out[x] = (first..last).fold(P::NEUTRAL, |m, c| P::pick(m, row[c as usize]));
     }
 }
 
