@@ -2,7 +2,6 @@
 //! the viewer (the camera looks along -z), row 0 at the top.
 
 use crate::scene::{Camera, Vec3};
-use polar_optics::Mueller;
 
 /// A camera ready to generate rays.
 #[derive(Clone, Debug)]
@@ -62,13 +61,10 @@ impl PinholeCamera {
         (p - self.position).dot(&self.forward)
     }
 
-    /// The single film rotation: Stokes for light arriving along `-d` in the implicit
-    /// frame `stokes_basis(-d)` into the conventions' per-pixel frame
-    /// `x_ref = normalize(d × u)`.
-    pub fn film_rotation(&self, d: &Vec3) -> Mueller {
-        let k = -d;
-        let x_ref = d.cross(&self.user_up).normalize();
-        polar_optics::rotate_stokes_basis(&k, &polar_optics::stokes_basis(&k), &x_ref)
+    /// The x axis of the conventions' per-pixel Stokes frame for the ray
+    /// direction `d`: `x_ref = normalize(d × u)` (then `y_ref = x_ref × d`).
+    pub fn film_frame(&self, d: &Vec3) -> Vec3 {
+        d.cross(&self.user_up).normalize()
     }
 }
 
@@ -101,17 +97,11 @@ mod tests {
 
     #[test]
     fn film_frame_at_the_centre_is_image_x() {
-        // Light polarized along world x (image right) must read S1 = +1 at the centre.
+        // At the image centre x_ref is image right (world x here) and y_ref = x_ref × d is image up.
         let c = cam();
         let d = c.direction(100.0, 50.0);
-        let k = -d;
-        let s_implicit =
-            polar_optics::rotate_stokes_basis(&k, &Vec3::x(), &polar_optics::stokes_basis(&k))
-                * polar_optics::stokes::linear(1.0, 0.0);
-        let s = c.film_rotation(&d) * s_implicit;
-        assert!(
-            (s - polar_optics::stokes::linear(1.0, 0.0)).norm() < 1e-12,
-            "{s}"
-        );
+        let x = c.film_frame(&d);
+        assert!((x - Vec3::x()).norm() < 1e-12, "{x}");
+        assert!((x.cross(&d) - Vec3::y()).norm() < 1e-12);
     }
 }

@@ -2,13 +2,18 @@
 //! estimation, multiple importance sampling (power heuristic, Veach 1997) and
 //! Russian roulette, generic over the [`Transport`] representation.
 //!
-//! Frames (Mitsuba 3's recipe): a camera path carries the throughput `T`, which
-//! maps Stokes light arriving along the current ray (travelling along `-d`, in
-//! the implicit frame `stokes_basis(-d)`) to Stokes at the camera in the frame
-//! `stokes_basis(-d0)` of the primary ray. BSDF matrices come in the local
-//! shading frame's implicit bases and are re-expressed in the world's implicit
-//! bases with `rotate_mueller_basis`; the film applies the one rotation into the
-//! conventions' per-pixel frame.
+//! Frames: a camera path carries the throughput `T` together with a frame: `T`
+//! maps Stokes light arriving along the current ray (travelling along `-d`) in
+//! the frame with x axis `path_x` (a world vector perpendicular to `d`) to
+//! Stokes at the camera in the conventions' per-pixel frame (`path_x = x_ref`
+//! on the primary ray, so the film needs no further rotation). A BSDF matrix
+//! comes with input basis `stokes_basis(-wi)` and output basis
+//! `stokes_basis(wo)` of local vectors: its output is rotated once into
+//! `path_x` (one rotation per vertex, shared by light and BSDF sampling), and
+//! its input basis, taken to world space, becomes the next `path_x`. This is the
+//! calculus of re-expressing every matrix in world-implicit bases with
+//! `rotate_mueller_basis` (Mitsuba 3) with a quarter of the rotations. Emitted
+//! Stokes (implicit frame of its direction) is rotated only when polarized.
 
 use crate::geometry::SurfaceHit;
 use crate::sampler::Sampler;
@@ -16,7 +21,7 @@ use crate::scene::Vec3;
 use crate::transport::Transport;
 use crate::world::World;
 use polar_bsdf::Polarization;
-use polar_optics::{Mueller, Stokes, rotate_mueller_basis, stokes_basis};
+use polar_optics::{Mueller, Stokes, rotate_stokes_basis, stokes_basis};
 
 /// Orthonormal shading frame: `z = n`, `x = stokes_basis(n)`, `y = z × x`.
 struct Frame {
@@ -42,29 +47,15 @@ impl Frame {
     fn to_world(&self, v: &Vec3) -> Vec3 {
         self.x * v.x + self.y * v.y + self.z * v.z
     }
+}
 
-    /// A local-frame Mueller matrix (bases `stokes_basis(-wi)`, `stokes_basis(wo)` of
-    /// local vectors) re-expressed in the world's implicit bases.
-    fn mueller_to_world(
-        &self,
-        m: &Mueller,
-        wo: &Vec3,
-        wi: &Vec3,
-        wo_w: &Vec3,
-        wi_w: &Vec3,
-    ) -> Mueller {
-        let (k_in, k_out) = (-wi_w, *wo_w);
-        let in_current = self.to_world(&stokes_basis(&-wi));
-        let out_current = self.to_world(&stokes_basis(wo));
-        rotate_mueller_basis(
-            m,
-            &k_in,
-            &in_current,
-            &stokes_basis(&k_in),
-            &k_out,
-            &out_current,
-            &stokes_basis(&k_out),
-        )
+/// Re-expresses Stokes `s` travelling along `k` from the implicit frame
+/// `stokes_basis(k)` into the frame with x axis `x` (nothing to do when unpolarized).
+fn into_frame(s: &Stokes, k: &Vec3, x: &Vec3) -> Stokes {
+    if s[1] == 0.0 && s[2] == 0.0 && s[3] == 0.0 {
+        *s
+    } else {
+        rotate_stokes_basis(k, &stokes_basis(k), x) * s
     }
 }
 
@@ -89,11 +80,17 @@ enum Bounce {
 }
 
 /// One path sample along the primary direction `d0`: the Stokes vector arriving
-/// at the camera, in the implicit frame `stokes_basis(-d0)`.
-pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sampler) -> Stokes {
+/// at the camera, in the frame with x axis `x_ref` (the per-pixel camera frame).
+pub(crate) fn radiance<R: Transport>(
+    world: &World,
+    d0: &Vec3,
+    x_ref: &Vec3,
+    sampler: &mut Sampler,
+) -> Stokes {
     let settings = &world.scene.settings;
     let (mut o, mut d) = (world.camera.position, *d0);
     let mut throughput = R::identity();
+    let mut path_x = *x_ref;
     let mut sum = Stokes::zeros();
     let mut bounce = Bounce::Specular;
     let mut add =
@@ -107,7 +104,7 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
                         power_heuristic(*pdf, world.environment_pdf(n, &d))
                     }
                 };
-                add(&throughput, &le, w);
+                add(&throughput, &into_frame(&le, &-d, &path_x), w);
             }
             break;
         };
@@ -116,7 +113,7 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
                 Bounce::Specular => 1.0,
                 Bounce::Smooth { pdf, p, .. } => power_heuristic(*pdf, world.area_pdf(&hit, p)),
             };
-            add(&throughput, &le, w);
+            add(&throughput, &into_frame(&le, &-d, &path_x), w);
         }
         let shape = &world.scene.shapes[hit.shape];
         let Some(material) = shape.material.map(|m| &world.scene.materials[m].1) else {
@@ -129,13 +126,14 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
         let frame = Frame::new(shading_normal(&hit, &d, material.label()));
         let wo_w = -d;
         let wo = frame.to_local(&wo_w);
-        let to_world = |m: &Mueller, wi: &Vec3, wi_w: &Vec3| {
-            if R::MODEL == Polarization::None {
-                R::from_mueller(m)
-            } else {
-                R::from_mueller(&frame.mueller_to_world(m, &wo, wi, &wo_w, wi_w))
-            }
+        // The one rotation of this vertex: BSDF output basis into the path frame.
+        let out_rotation = (R::MODEL != Polarization::None)
+            .then(|| rotate_stokes_basis(&wo_w, &frame.to_world(&stokes_basis(&wo)), &path_x));
+        let to_path = |m: &Mueller| match &out_rotation {
+            Some(r) => R::from_mueller(&(r * m)),
+            None => R::from_mueller(m),
         };
+        let in_basis = |wi: &Vec3| frame.to_world(&stokes_basis(&-wi));
 
         // Next-event estimation.
         if let Some(ls) = world.sample_light(&hit.p, &frame.z, sampler.next_3d()) {
@@ -154,11 +152,8 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
                     } else {
                         power_heuristic(ls.pdf, bsdf.pdf(&wo, &wi))
                     };
-                    add(
-                        &throughput.then(&to_world(&f, &wi, &ls.wi)),
-                        &ls.stokes,
-                        w / ls.pdf,
-                    );
+                    let le = into_frame(&ls.stokes, &-ls.wi, &in_basis(&wi));
+                    add(&throughput.then(&to_path(&f)), &le, w / ls.pdf);
                 }
             }
         }
@@ -168,7 +163,8 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
             break;
         };
         let wi_w = frame.to_world(&s.wi);
-        throughput = throughput.then(&to_world(&s.weight, &s.wi, &wi_w));
+        throughput = throughput.then(&to_path(&s.weight));
+        path_x = in_basis(&s.wi);
         bounce = if s.is_delta {
             Bounce::Specular
         } else {

@@ -1,5 +1,5 @@
 //! The render driver: rayon over tiles, per-pixel seeded samples, the film
-//! (one rotation into the per-pixel camera frame) and the first-hit ground truth.
+//! (Stokes in the per-pixel camera frame) and the first-hit ground truth.
 
 use crate::Error;
 use crate::integrator::radiance;
@@ -152,7 +152,7 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
                 let mut sampler = Sampler::new(settings.seed, pixel, u64::from(s));
                 let [jx, jy] = sampler.next_2d();
                 let d = world.camera.direction(x as f64 + jx, y as f64 + jy);
-                sum += world.camera.film_rotation(&d) * radiance::<R>(world, &d, &mut sampler);
+                sum += radiance::<R>(world, &d, &world.camera.film_frame(&d), &mut sampler);
             }
             let mean = sum / f64::from(settings.spp);
             tile.stokes.push([
