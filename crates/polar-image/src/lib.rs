@@ -8,7 +8,9 @@ use thiserror::Error;
 #[derive(Debug, Error, PartialEq, Eq)]
 pub enum ImageError {
     /// The buffer length does not equal `width * height * C`.
-    #[error("buffer of {len} values does not fit a {width}x{height} image with {channels} channel(s)")]
+    #[error(
+        "buffer of {len} values does not fit a {width}x{height} image with {channels} channel(s)"
+    )]
     BufferSize {
         /// Buffer length given.
         len: usize,
@@ -44,7 +46,11 @@ pub type PolarizerStack = Image<f32, 4>;
 impl<T: Clone + Default, const C: usize> Image<T, C> {
     /// An image filled with `T::default()`.
     pub fn new(width: usize, height: usize) -> Self {
-        Self { width, height, data: vec![T::default(); width * height * C] }
+        Self {
+            width,
+            height,
+            data: vec![T::default(); width * height * C],
+        }
     }
 }
 
@@ -52,9 +58,18 @@ impl<T, const C: usize> Image<T, C> {
     /// Wraps an interleaved row-major buffer, checking its length.
     pub fn from_vec(width: usize, height: usize, data: Vec<T>) -> Result<Self, ImageError> {
         if data.len() != width * height * C {
-            return Err(ImageError::BufferSize { len: data.len(), width, height, channels: C });
+            return Err(ImageError::BufferSize {
+                len: data.len(),
+                width,
+                height,
+                channels: C,
+            });
         }
-        Ok(Self { width, height, data })
+        Ok(Self {
+            width,
+            height,
+            data,
+        })
     }
 
     /// Width in pixels.
@@ -103,11 +118,19 @@ impl<T, const C: usize> Image<T, C> {
     }
 
     /// Checks that `other` has the same size.
-    pub fn check_same_size<U, const D: usize>(&self, other: &Image<U, D>) -> Result<(), ImageError> {
+    pub fn check_same_size<U, const D: usize>(
+        &self,
+        other: &Image<U, D>,
+    ) -> Result<(), ImageError> {
         if self.size() == other.size() {
             Ok(())
         } else {
-            Err(ImageError::SizeMismatch(self.width, self.height, other.width, other.height))
+            Err(ImageError::SizeMismatch(
+                self.width,
+                self.height,
+                other.width,
+                other.height,
+            ))
         }
     }
 }
@@ -117,7 +140,11 @@ impl<T: Copy, const C: usize> Image<T, C> {
     pub fn channel(&self, c: usize) -> Gray<T> {
         assert!(c < C, "channel {c} out of range for a {C}-channel image");
         let data = self.pixels().iter().map(|p| p[c]).collect();
-        Gray { width: self.width, height: self.height, data }
+        Gray {
+            width: self.width,
+            height: self.height,
+            data,
+        }
     }
 
     /// Builds a `C`-channel image from `C` single-channel images of equal size.
@@ -130,7 +157,11 @@ impl<T: Copy, const C: usize> Image<T, C> {
         for i in 0..w * h {
             data.extend(channels.iter().map(|ch| ch.data[i]));
         }
-        Ok(Self { width: w, height: h, data })
+        Ok(Self {
+            width: w,
+            height: h,
+            data,
+        })
     }
 }
 
