@@ -39,6 +39,12 @@ pub fn linear_rotator(theta: f64) -> LinearMueller {
 #[inline]
 pub fn rotator(theta: f64) -> Mueller {
     let (s, c) = (2.0 * theta).sin_cos();
+    rotator_cos_sin(c, s)
+}
+
+/// [`rotator`] from `cos 2θ` and `sin 2θ` (see `frame::double_angle`, which needs no trigonometry).
+#[inline]
+pub fn rotator_cos_sin(c: f64, s: f64) -> Mueller {
     #[rustfmt::skip]
     let m = Mueller::new(
         1.0, 0.0, 0.0, 0.0,

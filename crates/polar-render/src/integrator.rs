@@ -21,6 +21,7 @@ use crate::scene::Vec3;
 use crate::transport::Transport;
 use crate::world::World;
 use polar_bsdf::Polarization;
+use polar_optics::frame::{double_angle, rotate_rows};
 use polar_optics::{Mueller, Stokes, rotate_stokes_basis, stokes_basis};
 
 /// Orthonormal shading frame: `z = n`, `x = stokes_basis(n)`, `y = z × x`.
@@ -128,9 +129,9 @@ pub(crate) fn radiance<R: Transport>(
         let wo = frame.to_local(&wo_w);
         // The one rotation of this vertex: BSDF output basis into the path frame.
         let out_rotation = (R::MODEL != Polarization::None)
-            .then(|| rotate_stokes_basis(&wo_w, &frame.to_world(&stokes_basis(&wo)), &path_x));
-        let to_path = |m: &Mueller| match &out_rotation {
-            Some(r) => R::from_mueller(&(r * m)),
+            .then(|| double_angle(&wo_w, &frame.to_world(&stokes_basis(&wo)), &path_x));
+        let to_path = |m: &Mueller| match out_rotation {
+            Some(r) => R::from_mueller(&rotate_rows(m, r)),
             None => R::from_mueller(m),
         };
         let in_basis = |wi: &Vec3| frame.to_world(&stokes_basis(&-wi));
