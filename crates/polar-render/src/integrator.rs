@@ -136,26 +136,28 @@ pub(crate) fn radiance<R: Transport>(
         };
         let in_basis = |wi: &Vec3| frame.to_world(&stokes_basis(&-wi));
 
-        // Next-event estimation.
-        if let Some(ls) = world.sample_light(&hit.p, &frame.z, sampler.next_3d()) {
+        // Next-event estimation: every sun, and one light with extent.
+        let picked = world.sample_light(&hit.p, &frame.z, sampler.next_3d());
+        for ls in world.sun_samples().chain(picked) {
             let wi = frame.to_local(&ls.wi);
             let f = bsdf.eval(&wo, &wi);
-            if f[(0, 0)] > 0.0 {
-                let origin = spawn(&hit, &ls.wi);
-                let tmax = if ls.dist.is_finite() {
-                    (ls.dist - (origin - hit.p).norm()) * (1.0 - 1e-7)
+            if f[(0, 0)] <= 0.0 {
+                continue;
+            }
+            let origin = spawn(&hit, &ls.wi);
+            let tmax = if ls.dist.is_finite() {
+                (ls.dist - (origin - hit.p).norm()) * (1.0 - 1e-7)
+            } else {
+                f64::INFINITY
+            };
+            if world.accel.unoccluded(&origin, &ls.wi, 0.0, tmax) {
+                let w = if ls.is_delta {
+                    1.0
                 } else {
-                    f64::INFINITY
+                    power_heuristic(ls.pdf, bsdf.pdf(&wo, &wi))
                 };
-                if world.accel.unoccluded(&origin, &ls.wi, 0.0, tmax) {
-                    let w = if ls.is_delta {
-                        1.0
-                    } else {
-                        power_heuristic(ls.pdf, bsdf.pdf(&wo, &wi))
-                    };
-                    let le = into_frame(&ls.stokes, &-ls.wi, &in_basis(&wi));
-                    add(&throughput.then(&to_path(&f)), &le, w / ls.pdf);
-                }
+                let le = into_frame(&ls.stokes, &-ls.wi, &in_basis(&wi));
+                add(&throughput.then(&to_path(&f)), &le, w / ls.pdf);
             }
         }
 

@@ -7,13 +7,12 @@ use crate::scene::{Emission, Light, Scene, Vec3};
 use polar_optics::Stokes;
 use std::f64::consts::PI;
 
-/// One light source as the integrator picks it (uniformly among all of them).
+/// A light with extent, as the integrator picks it (uniformly among them; suns,
+/// being delta lights, are not picked but all sampled at every vertex).
 #[derive(Clone, Debug)]
 enum LightRef {
     /// The constant environment.
     Environment(Emission),
-    /// A directional light (unit direction toward the sun).
-    Sun(Vec3, Emission),
     /// An emissive shape: its primitives (indices into `Accel::prims`) with an
     /// area CDF, and the total area.
     Area {
@@ -32,7 +31,7 @@ pub(crate) struct LightSample {
     pub dist: f64,
     /// Incident Stokes vector in the implicit frame of its propagation direction `-wi`.
     pub stokes: Stokes,
-    /// Solid-angle density including the light choice; for a sun, the choice probability.
+    /// Solid-angle density including the light choice; 1 for a sun.
     pub pdf: f64,
     /// The light is a delta distribution (sun): no MIS.
     pub is_delta: bool,
@@ -44,6 +43,8 @@ pub(crate) struct World<'a> {
     pub accel: Accel,
     pub camera: PinholeCamera,
     lights: Vec<LightRef>,
+    /// Directional lights: unit direction toward the sun and its emission.
+    suns: Vec<(Vec3, Emission)>,
     environment: Option<Emission>,
     /// Index in `lights` of each emissive shape (for MIS when a BSDF ray hits it).
     area_index: Vec<Option<usize>>,
@@ -62,17 +63,17 @@ impl<'a> World<'a> {
     /// Builds the BVH and light tables of a validated scene.
     pub fn new(scene: &'a Scene) -> Self {
         let accel = Accel::build(scene);
-        let mut lights: Vec<LightRef> = scene
-            .lights
-            .iter()
-            .map(|l| match l {
-                Light::Environment(e) => LightRef::Environment(*e),
+        let mut lights = Vec::new();
+        let mut suns = Vec::new();
+        for l in &scene.lights {
+            match l {
+                Light::Environment(e) => lights.push(LightRef::Environment(*e)),
                 Light::Sun {
                     direction,
                     emission,
-                } => LightRef::Sun(direction.normalize(), *emission),
-            })
-            .collect();
+                } => suns.push((direction.normalize(), *emission)),
+            }
+        }
         let mut area_index = vec![None; scene.shapes.len()];
         for (s, shape) in scene.shapes.iter().enumerate() {
             if shape.emission.is_none_or(|e| e.value == 0.0) {
@@ -108,6 +109,7 @@ impl<'a> World<'a> {
             scene,
             accel,
             lights,
+            suns,
             environment,
             area_index,
         }
@@ -155,7 +157,20 @@ impl<'a> World<'a> {
         }
     }
 
-    /// Samples one light as seen from `p` with shading normal `n` (visibility not tested).
+    /// Every sun as a light sample (delta lights cost no sampling and each is
+    /// taken at every vertex: lower variance than picking them with the others).
+    pub fn sun_samples(&self) -> impl Iterator<Item = LightSample> + '_ {
+        self.suns.iter().map(|(dir, e)| LightSample {
+            wi: *dir,
+            dist: f64::INFINITY,
+            stokes: e.stokes(),
+            pdf: 1.0,
+            is_delta: true,
+        })
+    }
+
+    /// Samples one light with extent (environment or emissive shape) as seen from
+    /// `p` with shading normal `n` (visibility not tested); suns are in [`Self::sun_samples`].
     pub fn sample_light(&self, p: &Vec3, n: &Vec3, u: [f64; 3]) -> Option<LightSample> {
         if self.lights.is_empty() {
             return None;
@@ -174,13 +189,6 @@ impl<'a> World<'a> {
                     is_delta: false,
                 })
             }
-            LightRef::Sun(dir, e) => Some(LightSample {
-                wi: *dir,
-                dist: f64::INFINITY,
-                stokes: e.stokes(),
-                pdf: pick,
-                is_delta: true,
-            }),
             LightRef::Area {
                 shape,
                 prims,
