@@ -1,7 +1,7 @@
 //! Polarized path tracer: scene description (TOML file or Rust API), geometry in
 //! an obvhs BVH, a pinhole camera, lights (area, environment, sun), a
 //! unidirectional Mueller/Stokes path tracer with NEE + MIS, and the film with
-//! first-hit ground truth, following `shared/spec/conventions.md`.
+//! first-hit ground truth, following `docs/conventions.md`.
 //!
 //! ```no_run
 //! let scene = polar_render::load_scene(std::path::Path::new("scene.toml"))?;
