@@ -220,23 +220,25 @@ impl Accel {
     pub fn closest(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
         let bvh = self.bvh.as_ref()?;
         let mut hit = RayHit::none();
-        let found = bvh.ray_traverse(Self::f32_ray(o, d, tmax), &mut hit, |ray, id| {
+        // The closest candidate in f64, kept as found (no second intersection test).
+        let mut best: Option<PrimHit> = None;
+        bvh.ray_traverse(Self::f32_ray(o, d, tmax), &mut hit, |ray, id| {
             let limit = f64::from(ray.tmax).min(tmax);
-            self.prims[id]
-                .intersect(o, d, tmin, limit * (1.0 + 1e-6))
-                .map_or(f32::INFINITY, |h| h.0 as f32)
+            let Some((t, b1, b2)) = self.prims[id].intersect(o, d, tmin, limit * (1.0 + 1e-6))
+            else {
+                return f32::INFINITY;
+            };
+            if t < tmax && best.as_ref().is_none_or(|b| t < b.t) {
+                best = Some(PrimHit {
+                    prim: id,
+                    t,
+                    b1,
+                    b2,
+                });
+            }
+            t as f32
         });
-        if !found {
-            return None;
-        }
-        let id = hit.primitive_id as usize;
-        let (t, b1, b2) = self.prims[id].intersect(o, d, tmin, tmax)?;
-        Some(PrimHit {
-            prim: id,
-            t,
-            b1,
-            b2,
-        })
+        best
     }
 
     /// `true` when nothing blocks the segment from `o` along `d` over `(tmin, tmax)`.
