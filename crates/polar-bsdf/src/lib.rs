@@ -138,6 +138,15 @@ impl Bsdf {
         self.model().has_delta()
     }
 
+    /// Whether every lobe is a delta (smooth conductor or dielectric, sheets): then
+    /// [`Self::eval`] is zero everywhere and a renderer can skip light sampling.
+    pub fn is_delta(&self) -> bool {
+        match self {
+            Bsdf::Lambertian(_) | Bsdf::Plastic(_) => false,
+            Bsdf::Conductor(_) | Bsdf::Dielectric(_) | Bsdf::Sheet(_) => self.has_delta(),
+        }
+    }
+
     /// The cheapest exact transport model this BSDF needs.
     pub fn polarization(&self) -> Polarization {
         self.model().polarization()

@@ -375,6 +375,18 @@ impl Material {
         }
     }
 
+    /// Whether [`Self::bsdf`] depends on `uv` (a textured albedo); if not, a renderer
+    /// need not compute surface coordinates.
+    pub fn uses_uv(&self) -> bool {
+        match self {
+            Material::Lambertian(LambertianParams { albedo, .. })
+            | Material::Plastic(PlasticParams { albedo, .. }) => {
+                !matches!(albedo, Texture::Constant(_))
+            }
+            _ => false,
+        }
+    }
+
     /// The cheapest exact transport model the material needs (the same at every `uv`).
     pub fn polarization(&self) -> Polarization {
         self.bsdf([0.5, 0.5]).polarization()

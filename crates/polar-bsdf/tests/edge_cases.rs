@@ -62,3 +62,24 @@ fn degenerate_directions_give_finite_results() {
         }
     }
 }
+
+#[test]
+fn is_delta_exactly_when_eval_is_zero_everywhere() {
+    // A renderer skips light sampling on `is_delta`: that must lose nothing
+    // (exact zeros), and smooth-lobed BSDFs must not claim it.
+    for (name, bsdf) in delta_only() {
+        assert!(bsdf.is_delta(), "{name}");
+        for wo in special_directions() {
+            for wi in special_directions() {
+                assert_eq!(
+                    bsdf.eval(&wo, &wi),
+                    polar_optics::Mueller::zeros(),
+                    "{name}"
+                );
+            }
+        }
+    }
+    for (name, bsdf) in smooth_lobed() {
+        assert!(!bsdf.is_delta(), "{name}");
+    }
+}

@@ -48,6 +48,7 @@ fn every_material_parses_validates_and_builds() {
         let m = parse(text);
         m.validate().unwrap_or_else(|e| panic!("{text}: {e}"));
         assert_eq!(m.label(), label, "{text}");
+        assert_eq!(m.uses_uv(), text.contains("checkerboard"), "{text}");
         let wo = nalgebra::Vector3::new(0.3, 0.1, 0.9).normalize();
         let s = m.bsdf([0.3, 0.7]).sample(&wo, [0.4, 0.6, 0.2]);
         assert!(

@@ -45,7 +45,7 @@ pub(crate) struct SurfaceHit {
     pub ng: Vec3,
     /// Shading normal (interpolated or exact), in the same hemisphere as `ng`.
     pub ns: Vec3,
-    /// Texture coordinates.
+    /// Texture coordinates (zero on a sphere whose material has no texture).
     pub uv: [f64; 2],
     /// Index of the shape hit.
     pub shape: usize,
@@ -259,13 +259,21 @@ impl Accel {
         match &self.prims[prim] {
             Primitive::Sphere { center, .. } => {
                 let n = (p - center).normalize();
-                let u = (n.y.atan2(n.x) / std::f64::consts::TAU).rem_euclid(1.0);
-                let v = n.z.clamp(-1.0, 1.0).acos() / std::f64::consts::PI;
+                // Spherical coordinates cost an atan2 and an acos: only for textures.
+                let uses_uv = scene.shapes[shape]
+                    .material
+                    .is_some_and(|m| scene.materials[m].1.uses_uv());
+                let uv = if uses_uv {
+                    let u = (n.y.atan2(n.x) / std::f64::consts::TAU).rem_euclid(1.0);
+                    [u, n.z.clamp(-1.0, 1.0).acos() / std::f64::consts::PI]
+                } else {
+                    [0.0; 2]
+                };
                 SurfaceHit {
                     p,
                     ng: n,
                     ns: n,
-                    uv: [u, v],
+                    uv,
                     shape,
                 }
             }

@@ -136,9 +136,13 @@ pub(crate) fn radiance<R: Transport>(
         };
         let in_basis = |wi: &Vec3| frame.to_world(&stokes_basis(&-wi));
 
-        // Next-event estimation: every sun, and one light with extent.
-        let picked = world.sample_light(&hit.p, &frame.z, sampler.next_3d());
-        for ls in world.sun_samples().chain(picked) {
+        // Next-event estimation: every sun, and one light with extent (none when
+        // every lobe is a delta; the random numbers are drawn anyway, so that the
+        // sample streams do not depend on it).
+        let u_light = sampler.next_3d();
+        let lights = (!bsdf.is_delta())
+            .then(|| (world.sun_samples()).chain(world.sample_light(&hit.p, &frame.z, u_light)));
+        for ls in lights.into_iter().flatten() {
             let wi = frame.to_local(&ls.wi);
             let f = bsdf.eval(&wo, &wi);
             if f[(0, 0)] <= 0.0 {
