@@ -14,7 +14,7 @@ use polar_datagen::{Error, merge, store};
 /// Make synthetic polarization-camera datasets with the polar-render path tracer.
 ///
 /// Every sample directory holds meta.json, raw.png (16-bit DoFP mosaic, 90/45/135/0 layout),
-/// stokes.exr (S0..S3) and gt/ (normal.exr, depth.exr, material.png, transparent.png), as in
+/// stokes.exr (S0..S3), polarizers.exr (I0, I45, I90, I135, noiseless) and gt/ (normal.exr, depth.exr, material.png, transparent.png), as in
 /// the project's conventions. Images are deterministic: the same suite and seed give
 /// byte-identical images whatever --jobs or --shard.
 ///

@@ -117,7 +117,8 @@ fn io_err(id: &str) -> impl Fn(polar_io::Error) -> Error + '_ {
     }
 }
 
-/// Writes meta.json, raw.png, stokes.exr and gt/ for one render into `dir`.
+/// Writes meta.json, raw.png, stokes.exr, polarizers.exr (the noiseless full-resolution
+/// images behind the four micro-polarizers) and gt/ for one render into `dir`.
 /// `scene_meta` is recorded verbatim as `meta.scene` (the sample parameters or the scene file).
 /// The sensor noise is seeded from the scene's render seed.
 pub fn write_sample(
@@ -140,6 +141,18 @@ pub fn write_sample(
         dir.join("stokes.exr"),
         &out.stokes,
         polar_io::STOKES_CHANNELS,
+    )
+    .map_err(io_err(id))?;
+    let polarizers = model
+        .polarizer_images(&out.stokes)
+        .map_err(|e| Error::Sample {
+            id: id.to_owned(),
+            message: e.to_string(),
+        })?;
+    polar_io::write_exr(
+        dir.join("polarizers.exr"),
+        &polarizers,
+        polar_io::POLARIZER_CHANNELS,
     )
     .map_err(io_err(id))?;
     polar_io::write_exr(gt.join("normal.exr"), &out.normal, polar_io::RGB_CHANNELS)

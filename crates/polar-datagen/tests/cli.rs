@@ -82,8 +82,8 @@ fn images_are_byte_identical_whatever_the_jobs_or_shards() {
     run_ok(&["suite", TINY, "--out", s(&s2), "--shard", "2/2", "--quiet"]);
     run_ok(&["merge", s(&s2), s(&s1), "--out", s(&merged)]);
     let reference = images(&a);
-    // tiny.toml ci: 2 families x 3 samples x 6 image files.
-    assert_eq!(reference.len(), 36, "{:?}", reference.keys());
+    // tiny.toml ci: 2 families x 3 samples x 7 image files.
+    assert_eq!(reference.len(), 42, "{:?}", reference.keys());
     assert!(reference == images(&b), "--jobs 2 differs from --jobs 1");
     assert!(
         reference == images(&merged),
@@ -142,6 +142,7 @@ fn a_killed_run_resumes_to_a_complete_consistent_dataset() {
                 "meta.json",
                 "raw.png",
                 "stokes.exr",
+                "polarizers.exr",
                 "gt/normal.exr",
                 "gt/depth.exr",
                 "gt/material.png",
@@ -375,4 +376,36 @@ fn render_is_seeded_and_rejects_bad_scene_files_before_rendering() {
     let r = run(&["render", s(&bad), "--out", s(&out)]);
     assert!(String::from_utf8_lossy(&r.stderr).contains("bitz"));
     assert!(!out.exists(), "output created for a bad scene");
+}
+
+/// `polarizers.exr` holds what the micro-polarizers see: decoding it with the
+/// closed-form Stokes of polar-optics gives back the rendered AoLP exactly, and
+/// S0 and DoLP scaled by the extinction ratio's `(1 + t²)` and `(1 − t²)/(1 + t²)`.
+#[test]
+fn polarizer_images_decode_to_the_rendered_stokes() {
+    use polar_optics::stokes::{aolp, dolp, linear_stokes_from_quad};
+    let t = tempfile::tempdir().unwrap();
+    let demo = t.path().join("demo");
+    run_ok(&["demo", "--out", s(&demo), "--size", "32", "--spp", "4"]);
+    let stokes = polar_io::read_exr(demo.join("stokes.exr"), polar_io::STOKES_CHANNELS).unwrap();
+    let quad =
+        polar_io::read_exr(demo.join("polarizers.exr"), polar_io::POLARIZER_CHANNELS).unwrap();
+    let mut s0_ratio: Option<f32> = None;
+    let mut checked = 0;
+    for (s, i) in stokes.pixels().iter().zip(quad.pixels()) {
+        let [q0, q1, q2] = linear_stokes_from_quad(i[0], i[1], i[2], i[3]);
+        if s[0] < 1e-3 || dolp(s[0], s[1], s[2]) < 0.05 {
+            continue;
+        }
+        // f32 sums of a few terms: relative error ~1e-6; 1e-4 leaves room and still
+        // catches a swapped channel (an error of order 1).
+        let ratio = *s0_ratio.get_or_insert(q0 / s[0]);
+        assert!((q0 / s[0] - ratio).abs() < 1e-4 * ratio, "S0 scale varies");
+        assert!(dolp(q0, q1, q2) <= dolp(s[0], s[1], s[2]) * (1.0 + 1e-4));
+        let d = (aolp(q0, q1, q2) - aolp(s[0], s[1], s[2])).abs();
+        let d = d.min(std::f32::consts::PI - d);
+        assert!(d < 1e-3, "AoLP differs by {d} rad");
+        checked += 1;
+    }
+    assert!(checked > 20, "only {checked} polarized pixels to check");
 }

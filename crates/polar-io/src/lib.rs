@@ -31,6 +31,9 @@ pub use validate::{Rule, Validation, check_channels, check_stokes, check_u8};
 pub const STOKES_CHANNELS: [&str; 4] = ["S0", "S1", "S2", "S3"];
 /// Channel names of a linear Stokes EXR (the vision output when S3 is unknown).
 pub const LINEAR_STOKES_CHANNELS: [&str; 3] = ["S0", "S1", "S2"];
+/// Channel names of the four polarizer images (`polarizers.exr`), in the order of
+/// `polar_image::PolarizerStack`.
+pub const POLARIZER_CHANNELS: [&str; 4] = ["I0", "I45", "I90", "I135"];
 /// Channel names of a 3-vector EXR such as `normal.exr`.
 pub const RGB_CHANNELS: [&str; 3] = ["R", "G", "B"];
 /// Channel name of a single-channel EXR (`depth.exr`, `dolp.exr`, `aolp.exr`, ...).
