@@ -70,7 +70,7 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
             cos_i,
         };
     }
-    if eta.norm() > PERFECT_CONDUCTOR {
+    if eta.norm_sqr() > PERFECT_CONDUCTOR * PERFECT_CONDUCTOR {
         let r_p = if cos_i > 0.0 { one } else { -one };
         let eta_cos_t = Complex64::new(0.0, f64::INFINITY);
         return FresnelAmplitudes {
@@ -88,7 +88,7 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
     if d.im == 0.0 {
         d.im = 0.0;
     }
-    let eta_cos_t = d.sqrt();
+    let eta_cos_t = principal_sqrt(d);
     let eta2_ci = eta * eta * cos_i;
     let r_s = (ci - eta_cos_t) / (ci + eta_cos_t);
     let r_p = (eta2_ci - eta_cos_t) / (eta2_ci + eta_cos_t);
@@ -101,6 +101,25 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
         t_p,
         eta_cos_t,
         cos_i,
+    }
+}
+
+/// The principal square root without trigonometry (num-complex goes through
+/// polar form: atan2 and sin_cos): with `m = |z|`, `√z = (√((m+a)/2), sign(b) √((m−a)/2))`
+/// for `z = a + ib`, taking the larger part first and the other as `b / 2t`
+/// (no cancellation). `b = +0` on the negative real axis gives `+i√|a|`.
+fn principal_sqrt(z: Complex64) -> Complex64 {
+    let (a, b) = (z.re, z.im);
+    let m = a.hypot(b);
+    if m == 0.0 {
+        return Complex64::new(0.0, b);
+    }
+    if a >= 0.0 {
+        let t = (0.5 * (m + a)).sqrt();
+        Complex64::new(t, b / (2.0 * t))
+    } else {
+        let t = (0.5 * (m - a)).sqrt();
+        Complex64::new(b.abs() / (2.0 * t), t.copysign(b))
     }
 }
 
@@ -171,4 +190,26 @@ pub fn reflection_mueller(cos_i: f64, eta: Complex64) -> Mueller {
 /// Mueller matrix of specular transmission in the s/p frames (energy-flux units).
 pub fn transmission_mueller(cos_i: f64, eta: Complex64) -> Mueller {
     fresnel_amplitudes(cos_i, eta).transmission_mueller()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn principal_sqrt_matches_num_complex_in_every_quadrant() {
+        // Relative 1e-15: a few ulps; both signs of zero imaginary parts on both real half-axes.
+        let parts = [0.0, -0.0, 1e-300, 0.04, -0.3, 2.0, -7.5, 1e20, -1e20];
+        for a in parts {
+            for b in parts {
+                let z = Complex64::new(a, b);
+                let (got, want) = (principal_sqrt(z), z.sqrt());
+                assert!(
+                    (got - want).norm() <= 1e-15 * want.norm(),
+                    "sqrt({z}) = {got}, num-complex {want}"
+                );
+                assert_eq!(got.im.is_sign_negative(), want.im.is_sign_negative(), "{z}");
+            }
+        }
+    }
 }
