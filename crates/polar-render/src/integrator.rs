@@ -60,6 +60,10 @@ fn into_frame(s: &Stokes, k: &Vec3, x: &Vec3) -> Stokes {
     }
 }
 
+/// Russian roulette starts at this bounce (Mitsuba's default `rr_depth`): earlier,
+/// it mostly kills glass paths whose throughput is still near 1, adding variance.
+const RR_DEPTH: u32 = 5;
+
 /// The power heuristic with exponent 2.
 fn power_heuristic(a: f64, b: f64) -> f64 {
     let (a2, b2) = (a * a, b * b);
@@ -181,7 +185,7 @@ pub(crate) fn radiance<R: Transport>(
                 n: frame.z,
             }
         };
-        if depth >= 3 {
+        if depth >= RR_DEPTH {
             let q = throughput.m00().clamp(0.0, 0.95);
             if sampler.next_1d() >= q {
                 break;
