@@ -60,14 +60,7 @@ impl Model for Conductor {
         let Some(ggx) = &self.roughness else {
             let wi = reflect_z(wo);
             let weight = reflection(self.eta, &V3::z(), wo, &wi);
-            return Some(BsdfSample {
-                wi,
-                weight,
-                pdf: 1.0,
-                is_delta: true,
-                is_transmission: false,
-                eta: 1.0,
-            });
+            return Some(BsdfSample::reflection(wi, weight, 1.0, true));
         };
         let m = ggx.sample_visible(wo, [u[1], u[2]]);
         let wi = reflect(wo, &m);
@@ -77,14 +70,7 @@ impl Model for Conductor {
         }
         // f cos / pdf = F G1(wi): D and G1(wo) cancel.
         let weight = reflection(self.eta, &m, wo, &wi) * ggx.g1(&wi, &m);
-        Some(BsdfSample {
-            wi,
-            weight,
-            pdf,
-            is_delta: false,
-            is_transmission: false,
-            eta: 1.0,
-        })
+        Some(BsdfSample::reflection(wi, weight, pdf, false))
     }
 
     fn has_delta(&self) -> bool {

@@ -44,8 +44,8 @@ impl Dielectric {
                     eta: etap,
                 })
             }
-            Some(_) => Some(delta_reflection(wr, r_mueller / r, r)),
-            None => Some(delta_reflection(wr, r_mueller, 1.0)),
+            Some(_) => Some(BsdfSample::reflection(wr, r_mueller / r, r, true)),
+            None => Some(BsdfSample::reflection(wr, r_mueller, 1.0, true)),
         }
     }
 
@@ -132,17 +132,6 @@ impl Dielectric {
             is_transmission,
             eta,
         })
-    }
-}
-
-fn delta_reflection(wi: V3, weight: Mueller, pdf: f64) -> BsdfSample {
-    BsdfSample {
-        wi,
-        weight,
-        pdf,
-        is_delta: true,
-        is_transmission: false,
-        eta: 1.0,
     }
 }
 

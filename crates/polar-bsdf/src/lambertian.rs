@@ -35,14 +35,12 @@ impl Model for Lambertian {
             return None;
         }
         let pdf = cosine_hemisphere_pdf(&wi);
-        Some(BsdfSample {
+        Some(BsdfSample::reflection(
             wi,
-            weight: depolarizer(self.albedo),
+            depolarizer(self.albedo),
             pdf,
-            is_delta: false,
-            is_transmission: false,
-            eta: 1.0,
-        })
+            false,
+        ))
     }
 
     fn has_delta(&self) -> bool {

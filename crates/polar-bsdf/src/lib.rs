@@ -82,6 +82,20 @@ pub struct BsdfSample {
     pub eta: f64,
 }
 
+impl BsdfSample {
+    /// A sample that stays on `wo`'s side (reflection, `eta = 1`).
+    pub fn reflection(wi: Vector3<f64>, weight: Mueller, pdf: f64, is_delta: bool) -> Self {
+        Self {
+            wi,
+            weight,
+            pdf,
+            is_delta,
+            is_transmission: false,
+            eta: 1.0,
+        }
+    }
+}
+
 /// A polarized BSDF at one surface point (a closed set, one `match` per method).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bsdf {

@@ -95,14 +95,7 @@ impl Model for Plastic {
                 let wi = reflect_z(wo);
                 let weight = reflection(self.eta.into(), &V3::z(), wo, &wi) / self.specular_prob;
                 let pdf = self.specular_prob;
-                return Some(BsdfSample {
-                    wi,
-                    weight,
-                    pdf,
-                    is_delta: true,
-                    is_transmission: false,
-                    eta: 1.0,
-                });
+                return Some(BsdfSample::reflection(wi, weight, pdf, true));
             }
             (Some(ggx), true) => reflect(wo, &ggx.sample_visible(wo, [u[1], u[2]])),
             (_, false) => cosine_hemisphere([u[1], u[2]]),
@@ -112,14 +105,7 @@ impl Model for Plastic {
             return None;
         }
         let weight = self.eval(wo, &wi) / pdf;
-        Some(BsdfSample {
-            wi,
-            weight,
-            pdf,
-            is_delta: false,
-            is_transmission: false,
-            eta: 1.0,
-        })
+        Some(BsdfSample::reflection(wi, weight, pdf, false))
     }
 
     fn has_delta(&self) -> bool {
