@@ -1,5 +1,5 @@
 //! The sample directory of `conventions.md`: `meta.json` (required) plus optional `raw.png`,
-//! `stokes.exr` and `gt/{normal,depth,clear}.exr`, `gt/{material,transparent}.png`.
+//! `stokes.exr` and `gt/{normal,depth,clear,transmission}.exr`, `gt/{material,transparent}.png`.
 //! Reading checks every file against the format's rules and that all images share one size;
 //! writing checks the same, then writes the whole directory atomically.
 
@@ -34,6 +34,9 @@ pub mod files {
     pub const GT_TRANSPARENT: &str = "gt/transparent.png";
     /// Float32 Y: S0 of the same view without the participating medium.
     pub const GT_CLEAR: &str = "gt/clear.exr";
+    /// Float32 Y in `[0, 1]`: transmittance of the medium along each pixel's central ray to
+    /// the first surface (an addition of this project, for dehazing).
+    pub const GT_TRANSMISSION: &str = "gt/transmission.exr";
 }
 
 /// Labels of `gt/material.png`.
@@ -64,6 +67,8 @@ pub struct GroundTruth {
     pub transparent: Option<Gray<u8>>,
     /// `gt/clear.exr`.
     pub clear: Option<Gray<f32>>,
+    /// `gt/transmission.exr`.
+    pub transmission: Option<Gray<f32>>,
 }
 
 /// One sample directory in memory.
@@ -86,8 +91,8 @@ pub fn read_sample(dir: impl AsRef<Path>) -> Result<Sample> {
 
 /// Reads a sample directory. `meta.json` must exist and hold a JSON object; every other file
 /// is read if present. With [`Validation::Check`]: S0 finite and `>= 0`, S1..S3, normals,
-/// depth and clear S0 finite (depth and clear also `>= 0`), material labels in 0..=3, the
-/// transparency mask 0 or 255. Mosaic size and equal sizes across files are always checked.
+/// depth and clear S0 finite (depth and clear also `>= 0`), transmission in `[0, 1]`,
+/// material labels in 0..=3, the transparency mask 0 or 255. Mosaic size and equal sizes across files are always checked.
 pub fn read_sample_with(dir: impl AsRef<Path>, validation: Validation) -> Result<Sample> {
     let dir = dir.as_ref();
     if !dir.is_dir() {
@@ -115,6 +120,9 @@ pub fn read_sample_with(dir: impl AsRef<Path>, validation: Validation) -> Result
                 .map(read_gray8_png)
                 .transpose()?,
             clear: opt(files::GT_CLEAR)?
+                .map(|p| read_exr(p, Y_CHANNEL))
+                .transpose()?,
+            transmission: opt(files::GT_TRANSMISSION)?
                 .map(|p| read_exr(p, Y_CHANNEL))
                 .transpose()?,
         },
@@ -210,6 +218,10 @@ fn check_sample(dir: &Path, s: &Sample, validation: Validation) -> Result<()> {
             gt.transparent.as_ref().map(Image::size),
         ),
         (files::GT_CLEAR, gt.clear.as_ref().map(Image::size)),
+        (
+            files::GT_TRANSMISSION,
+            gt.transmission.as_ref().map(Image::size),
+        ),
     ];
     for (name, size) in other_files {
         if let Some(size) = size {
@@ -223,7 +235,7 @@ fn check_sample(dir: &Path, s: &Sample, validation: Validation) -> Result<()> {
 }
 
 fn check_values(dir: &Path, s: &Sample) -> Result<()> {
-    use Rule::{Finite, FiniteNonNegative};
+    use Rule::{Finite, FiniteNonNegative, UnitInterval};
     let gt = &s.gt;
     if let Some(stokes) = &s.stokes {
         check_stokes(&dir.join(files::STOKES), stokes)?;
@@ -236,9 +248,13 @@ fn check_values(dir: &Path, s: &Sample) -> Result<()> {
             [Finite; 3],
         )?;
     }
-    for (name, image) in [(files::GT_DEPTH, &gt.depth), (files::GT_CLEAR, &gt.clear)] {
+    for (name, image, rule) in [
+        (files::GT_DEPTH, &gt.depth, FiniteNonNegative),
+        (files::GT_CLEAR, &gt.clear, FiniteNonNegative),
+        (files::GT_TRANSMISSION, &gt.transmission, UnitInterval),
+    ] {
         if let Some(image) = image {
-            check_channels(&dir.join(name), image, Y_CHANNEL, [FiniteNonNegative])?;
+            check_channels(&dir.join(name), image, Y_CHANNEL, [rule])?;
         }
     }
     if let Some(m) = &gt.material {
@@ -284,7 +300,8 @@ fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
         || gt.depth.is_some()
         || gt.material.is_some()
         || gt.transparent.is_some()
-        || gt.clear.is_some();
+        || gt.clear.is_some()
+        || gt.transmission.is_some();
     let mkdir = |p: &Path| std::fs::create_dir(p).map_err(|e| Error::io(p, "directory", e));
     mkdir(tmp)?;
     if has_gt {
@@ -301,7 +318,11 @@ fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
     if let Some(normal) = &gt.normal {
         write_exr(p(files::GT_NORMAL), normal, RGB_CHANNELS)?;
     }
-    for (name, image) in [(files::GT_DEPTH, &gt.depth), (files::GT_CLEAR, &gt.clear)] {
+    for (name, image) in [
+        (files::GT_DEPTH, &gt.depth),
+        (files::GT_CLEAR, &gt.clear),
+        (files::GT_TRANSMISSION, &gt.transmission),
+    ] {
         if let Some(image) = image {
             write_exr(p(name), image, Y_CHANNEL)?;
         }

@@ -26,6 +26,8 @@ pub enum Rule {
     Finite,
     /// Finite and `>= 0` (S0, depth, intensities).
     FiniteNonNegative,
+    /// In `[0, 1]` (transmittance, fractions).
+    UnitInterval,
 }
 
 impl Rule {
@@ -34,6 +36,7 @@ impl Rule {
             Rule::Any => true,
             Rule::Finite => v.is_finite(),
             Rule::FiniteNonNegative => v.is_finite() && v >= 0.0,
+            Rule::UnitInterval => (0.0..=1.0).contains(&v),
         }
     }
 
@@ -42,6 +45,7 @@ impl Rule {
             Rule::Any => "any value",
             Rule::Finite => "finite",
             Rule::FiniteNonNegative => "finite and >= 0",
+            Rule::UnitInterval => "in [0, 1]",
         }
     }
 }

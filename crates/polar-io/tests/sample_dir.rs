@@ -48,6 +48,7 @@ fn full_sample() -> Sample {
             material: Some(Gray::from_vec(W, H, labels).unwrap()),
             transparent: Some(Gray::from_vec(W, H, mask).unwrap()),
             clear: Some(Gray::from_vec(W, H, vec![0.75; W * H]).unwrap()),
+            transmission: Some(Gray::from_vec(W, H, vec![0.5; W * H]).unwrap()),
         },
     }
 }
@@ -70,6 +71,7 @@ fn full_sample_round_trip_is_exact() {
         files::STOKES,
         files::GT_NORMAL,
         files::GT_CLEAR,
+        files::GT_TRANSMISSION,
     ] {
         assert!(dir.join(f).is_file(), "{f}");
     }
@@ -231,7 +233,14 @@ fn invalid_ground_truth_values_are_refused_on_write() {
     bad_mask.gt.transparent.as_mut().unwrap().as_mut_slice()[0] = 1;
     let mut neg_depth = full_sample();
     neg_depth.gt.depth.as_mut().unwrap().as_mut_slice()[0] = -1.0;
+    // Transmittance above 1 (and NaN) is not a transmittance.
+    let mut over_one = full_sample();
+    over_one.gt.transmission.as_mut().unwrap().as_mut_slice()[2] = 1.01;
+    let mut nan_transmission = full_sample();
+    nan_transmission.gt.transmission.as_mut().unwrap().as_mut_slice()[0] = f32::NAN;
     for (s, file) in [
+        (over_one, files::GT_TRANSMISSION),
+        (nan_transmission, files::GT_TRANSMISSION),
         (inf_normal, files::GT_NORMAL),
         (bad_label, files::GT_MATERIAL),
         (bad_mask, files::GT_TRANSPARENT),
