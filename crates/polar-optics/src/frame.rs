@@ -93,6 +93,45 @@ pub fn rotate_mueller_basis(
     rotate_columns(&rows, double_angle(in_k, in_target, in_current))
 }
 
+/// Below this squared length `k_in × k_out` is treated as zero (forward or backward scattering).
+const COLLINEAR_SQ: f64 = 1e-24;
+
+/// The x axis of the scattering-plane frame: `normalize(k_in × k_out)`, the normal of the
+/// plane holding both propagation directions (Bohren & Huffman's `e_⊥`, up to a sign that
+/// does not change Stokes vectors). It is perpendicular to both directions, so it serves as
+/// the x axis of the incident (`y = k_in × x`) and of the scattered frame (`y = k_out × x`).
+/// Where `k_out = ±k_in` the plane is undefined and `stokes_basis(k_in)` is returned: every
+/// phase matrix is invariant under that choice there (isotropic forward, `diag(a, a, −a, −a)`
+/// backward).
+#[inline]
+pub fn scattering_axis(k_in: &Vector3<f64>, k_out: &Vector3<f64>) -> Vector3<f64> {
+    let c = k_in.cross(k_out);
+    let n2 = c.norm_squared();
+    if n2 > COLLINEAR_SQ {
+        c / n2.sqrt()
+    } else {
+        stokes_basis(k_in)
+    }
+}
+
+/// Re-expresses a matrix `m` given in the scattering-plane frame (x axis
+/// [`scattering_axis`] for both beams) in the implicit frames: input in
+/// `stokes_basis(k_in)`, output in `stokes_basis(k_out)`. The one place every phase
+/// matrix goes through.
+#[inline]
+pub fn from_scattering_plane(m: &Mueller, k_in: &Vector3<f64>, k_out: &Vector3<f64>) -> Mueller {
+    let s = scattering_axis(k_in, k_out);
+    rotate_mueller_basis(
+        m,
+        k_in,
+        &s,
+        &stokes_basis(k_in),
+        k_out,
+        &s,
+        &stokes_basis(k_out),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

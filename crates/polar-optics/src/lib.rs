@@ -1,7 +1,8 @@
 //! The physics of polarized light, written once and used by both the simulator
 //! and the analysis: Stokes vectors, Mueller matrices, Fresnel equations for
-//! dielectrics and conductors, reference-frame rotations, validity checks and
-//! the Lu–Chipman decomposition.
+//! dielectrics and conductors, reference-frame rotations, validity checks,
+//! the Lu–Chipman decomposition, and the phase matrices of participating media
+//! ([`scatter`]: Rayleigh, Henyey–Greenstein with depolarization).
 //!
 //! Conventions (see the project README, "Conventions"):
 //! - A Stokes vector is expressed in a reference frame `(x, y)` perpendicular to
@@ -22,6 +23,7 @@ pub mod error;
 pub mod frame;
 pub mod fresnel;
 pub mod mueller;
+pub mod scatter;
 pub mod stokes;
 pub mod validity;
 
@@ -31,4 +33,5 @@ pub use error::OpticsError;
 pub use frame::{rotate_mueller_basis, rotate_stokes_basis, stokes_basis};
 pub use fresnel::{FresnelAmplitudes, fresnel_amplitudes};
 pub use mueller::{LinearMueller, Mueller};
+pub use scatter::PhaseFunction;
 pub use stokes::{LinearStokes, LinearStokesFit, Stokes};
