@@ -32,6 +32,9 @@ step "front end vs polanalyser"
 step "Mitsuba 3: Stokes frame experiment"
 "$py" tools/mitsuba/polarizer_check.py --threads 2
 
+step "Mitsuba 3: polarized Rayleigh phase function in volpath"
+"$py" tools/mitsuba/rayleigh_check.py --threads 2
+
 step "BSDF Mueller matrices vs Mitsuba 3"
 "$py" tools/bsdf_crosscheck.py
 

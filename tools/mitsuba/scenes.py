@@ -3,14 +3,17 @@ pieces of the tools in this directory: Mitsuba set-up, Stokes EXR I/O,
 per-pixel camera rays and the comparison metrics.
 
 Mitsuba must be imported through `setup_mitsuba()` so that the LLVM backend
-finds Debian's libLLVM (DRJIT_LIBLLVM_PATH) and the thread count is set
-before the first kernel runs.
+finds Debian's libLLVM (DRJIT_LIBLLVM_PATH), the thread count is set
+before the first kernel runs and the polarized Rayleigh phase function
+(rayleigh_phase.py) is registered.
 """
 
 import os
 from pathlib import Path
 
 import numpy as np
+
+import rayleigh_phase
 
 VARIANT = "llvm_ad_mono_polarized"
 LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
@@ -63,7 +66,8 @@ OURS_SPP = {"conductor": 256, "roughconductor": 16384, "pplastic": 4096, "dielec
 
 
 def setup_mitsuba(threads=None):
-    """Imports Mitsuba with the LLVM polarized variant; returns (mi, dr)."""
+    """Imports Mitsuba with the LLVM polarized variant and registers the
+    polarized Rayleigh phase function; returns (mi, dr)."""
     os.environ.setdefault("DRJIT_LIBLLVM_PATH", LIBLLVM)
     import drjit as dr
     import mitsuba as mi
@@ -72,6 +76,7 @@ def setup_mitsuba(threads=None):
     mi.set_log_level(mi.LogLevel.Error)
     if threads is not None:
         dr.set_thread_count(threads)
+    rayleigh_phase.register(mi, dr)
     return mi, dr
 
 
