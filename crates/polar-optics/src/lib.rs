@@ -2,7 +2,7 @@
 //! and the analysis: Stokes vectors, Mueller matrices, Fresnel equations for
 //! dielectrics and conductors, reference-frame rotations, validity checks,
 //! the Lu–Chipman decomposition, and the phase matrices of participating media
-//! ([`scatter`]: Rayleigh, Henyey–Greenstein with depolarization).
+//! ([`scatter`]: Rayleigh, Henyey–Greenstein with depolarization, Mie spheres).
 //!
 //! Conventions (see the project README, "Conventions"):
 //! - A Stokes vector is expressed in a reference frame `(x, y)` perpendicular to

@@ -1,5 +1,5 @@
 //! Phase matrices of participating media: Rayleigh, Henyey–Greenstein with a
-//! depolarization parameter, and their sampling.
+//! depolarization parameter, Mie spheres ([`MieTable`]), and their sampling.
 //!
 //! Conventions:
 //! - `k_in` is the propagation direction of the incident light, `k_out` that of the
@@ -20,12 +20,17 @@
 //!   the amplitude matrix `diag(S1, S2)` of B&H acts on `(E_⊥, E_∥)`, and the plane matrix
 //!   is [`crate::mueller::from_diagonal_jones`]`(S1, S2)` up to normalisation.
 
+mod mie;
+
+pub use mie::{Amplitudes, MieCoefficients, MieTable};
+
 use crate::block::BlockDiagonal;
 use crate::error::OpticsError;
 use crate::frame::{from_scattering_plane, stokes_basis};
 use crate::mueller::Mueller;
 use nalgebra::{Matrix2, Vector3};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// `1 / 4π`: the isotropic phase function.
 const INV_4PI: f64 = 0.25 / PI;
@@ -98,6 +103,9 @@ pub enum PhaseFunction {
         /// Fraction of Rayleigh's polarization removed, in `[0, 1]` (1: scalar HG).
         depolarization: f64,
     },
+    /// A homogeneous sphere (Mie theory), tabulated: see [`MieTable`] for the accuracy.
+    /// Couples circular polarization (`S34 ≠ 0`). Shared, as tables can be large.
+    Mie(Arc<MieTable>),
 }
 
 impl PhaseFunction {
@@ -113,7 +121,7 @@ impl PhaseFunction {
     /// Checks the parameters of a variant built directly.
     pub fn validate(&self) -> Result<(), OpticsError> {
         match *self {
-            Self::Rayleigh => Ok(()),
+            Self::Rayleigh | Self::Mie(_) => Ok(()),
             Self::HenyeyGreenstein { g, depolarization } => {
                 if g.is_nan() || g.abs() >= 1.0 {
                     return Err(OpticsError::OutOfRange {
@@ -138,14 +146,15 @@ impl PhaseFunction {
     /// against rounding; NaN gives NaN).
     pub fn plane_elements(&self, cos_theta: f64) -> PlaneElements {
         let mu = cos_theta.clamp(-1.0, 1.0);
-        match *self {
+        match self {
             Self::Rayleigh => rayleigh_shape(mu).scaled(RAYLEIGH_NORM),
             Self::HenyeyGreenstein { g, depolarization } => {
-                let p = henyey_greenstein(g, mu);
+                let p = henyey_greenstein(*g, mu);
                 let mut e = rayleigh_shape(mu).scaled((1.0 - depolarization) * p / (1.0 + mu * mu));
                 e.s11 = p;
                 e
             }
+            Self::Mie(table) => table.plane_elements(mu),
         }
     }
 
@@ -162,12 +171,13 @@ impl PhaseFunction {
     }
 
     /// Solid-angle density of [`PhaseFunction::sample`] at scattering cosine `cos_theta`;
-    /// equal to `S11` (the `M00` of [`PhaseFunction::eval`]).
+    /// equal to `S11` (the `M00` of [`PhaseFunction::eval`]; for Mie, of the table).
     pub fn pdf(&self, cos_theta: f64) -> f64 {
         let mu = cos_theta.clamp(-1.0, 1.0);
-        match *self {
+        match self {
             Self::Rayleigh => RAYLEIGH_NORM * (1.0 + mu * mu),
-            Self::HenyeyGreenstein { g, .. } => henyey_greenstein(g, mu),
+            Self::HenyeyGreenstein { g, .. } => henyey_greenstein(*g, mu),
+            Self::Mie(table) => table.pdf(mu),
         }
     }
 
@@ -188,6 +198,7 @@ impl PhaseFunction {
     /// Henyey–Greenstein: the usual inversion `μ = (1 + g² − s²)/2g`,
     /// `s = (1 − g²)/(1 + g v)`, `v = 2u − 1`, rewritten without the division by `g`:
     /// `μ = (v + g (3 − g² + (1 + g²) v² + 2g v)/2) / (1 + g v)²` (exact at `g = 0`).
+    /// Mie: the tabulated CDF (see [`MieTable::sample_cos_theta`]).
     pub fn sample_cos_theta(&self, u: f64) -> f64 {
         let mu = match *self {
             Self::Rayleigh => {
@@ -201,6 +212,7 @@ impl PhaseFunction {
                 let d = 1.0 + g * v;
                 (v + 0.5 * g * (3.0 - g * g + (1.0 + g * g) * v * v + 2.0 * g * v)) / (d * d)
             }
+            Self::Mie(ref table) => table.sample_cos_theta(u),
         };
         mu.clamp(-1.0, 1.0)
     }
@@ -210,14 +222,17 @@ impl PhaseFunction {
     pub fn couples_circular(&self) -> bool {
         match self {
             Self::Rayleigh | Self::HenyeyGreenstein { .. } => false,
+            Self::Mie(_) => true,
         }
     }
 
-    /// The asymmetry parameter `⟨cos θ⟩ = ∫ S11 cos θ dΩ` (0 for Rayleigh, `g` for HG).
+    /// The asymmetry parameter `⟨cos θ⟩ = ∫ S11 cos θ dΩ` (0 for Rayleigh, `g` for HG,
+    /// the series value for Mie, which the table matches to its interpolation error).
     pub fn mean_cosine(&self) -> f64 {
-        match *self {
+        match self {
             Self::Rayleigh => 0.0,
-            Self::HenyeyGreenstein { g, .. } => g,
+            Self::HenyeyGreenstein { g, .. } => *g,
+            Self::Mie(table) => table.coefficients().asymmetry(),
         }
     }
 }
