@@ -2,7 +2,8 @@
 //! and the analysis: Stokes vectors, Mueller matrices, Fresnel equations for
 //! dielectrics and conductors, reference-frame rotations, validity checks,
 //! the Lu–Chipman decomposition, and the phase matrices of participating media
-//! ([`scatter`]: Rayleigh, Henyey–Greenstein with depolarization, Mie spheres).
+//! ([`scatter`]: Rayleigh, Henyey–Greenstein with depolarization, Mie spheres) and a
+//! single-scattering Rayleigh sky ([`sky`]).
 //!
 //! Conventions (see the project README, "Conventions"):
 //! - A Stokes vector is expressed in a reference frame `(x, y)` perpendicular to
@@ -24,6 +25,7 @@ pub mod frame;
 pub mod fresnel;
 pub mod mueller;
 pub mod scatter;
+pub mod sky;
 pub mod stokes;
 pub mod validity;
 
