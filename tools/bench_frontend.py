@@ -6,9 +6,11 @@ polanalyser chain (float64, as polanalyser computes it):
 polar-sensor (f32): raw -> S0, S1, S2, DoLP, AoLP, fused, caller-allocated planes
   (crates/polar-sensor/examples/bench_frontend.rs, built with cargo --release).
 Both: best of N runs after a warm-up (the least disturbed by other processes).
-The Rust example is built twice: for the x86-64 baseline (SSE2, what a plain
-`cargo build` gives) and with `-C target-cpu=native` (AVX2/AVX-512 where the CPU has
-them; OpenCV dispatches to those at run time too).
+The Rust example is built twice: the default build (x86-64 baseline code, whose hot
+row kernels are also compiled for AVX2+FMA and AVX-512 and picked at run time by CPU
+feature detection; OpenCV dispatches at run time too) and with `-C target-cpu=native`.
+The SIMD target picked at run time and the machine load (1-minute load average,
+before and after) are printed with the table.
 The Rust side also measures memory bandwidth (memcpy and a STREAM-scale loop) and
 reports the fused chain against the bytes it must move.
 
@@ -56,14 +58,13 @@ def main():
 
     raw = cv2.imread(args.frame, cv2.IMREAD_UNCHANGED)
     muellers = [pa.polarizer(np.deg2rad(a)) for a in (0, 45, 90, 135)]
-    t_py = best_time(max(3, args.reps // 3), lambda: polanalyser_chain(raw, muellers))
 
     target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
     builds = {
-        "x86-64 baseline (SSE2)": (target, {}),
+        "default": (target, {}),
         "-C target-cpu=native": (target / "native-cpu", {"RUSTFLAGS": "-C target-cpu=native"}),
     }
-    results = {}
+    exes = {}
     for label, (tdir, env) in builds.items():
         subprocess.run(
             ["cargo", "build", "--release", "--locked", "-p", "polar-sensor", "--example", "bench_frontend"],
@@ -72,16 +73,23 @@ def main():
             stderr=subprocess.DEVNULL,
             env={**os.environ, "CARGO_TARGET_DIR": str(tdir), **env},
         )
-        exe = tdir / "release" / "examples" / "bench_frontend"
+        exes[label] = tdir / "release" / "examples" / "bench_frontend"
+
+    # Timed back to back once everything is built, so that all rows share the machine's load.
+    load_before = os.getloadavg()[0]
+    t_py = best_time(max(3, args.reps // 3), lambda: polanalyser_chain(raw, muellers))
+    results = {}
+    for label, exe in exes.items():
         out = subprocess.run([str(exe), args.frame, str(args.reps), "--json"], check=True, capture_output=True, text=True)
         results[label] = json.loads(out.stdout)
 
     h, w = raw.shape
     first = next(iter(results.values()))
     print(f"{w}x{h} {raw.dtype} frame, {first['threads']} threads; best of N runs; OpenCV {cv2.__version__}")
+    print(f"load average (1 min, {os.cpu_count()} CPUs): {load_before:.2f} before, {os.getloadavg()[0]:.2f} after")
     for label, rs in results.items():
         print(
-            f"[{label}] bandwidth (read+write): memcpy {rs['memcpy_gb_s']:.2f} GB/s, STREAM-scale "
+            f"[{label}] SIMD target picked at run time: {rs['simd']}; bandwidth (read+write): memcpy {rs['memcpy_gb_s']:.2f} GB/s, STREAM-scale "
             f"{rs['stream_gb_s']:.2f} GB/s; fused chain moves {rs['bytes_moved'] / 1e6:.1f} MB -> bound {rs['bound_s'] * 1e3:.2f} ms"
         )
     print()

@@ -11,7 +11,7 @@
 use std::time::{Duration, Instant};
 
 use polar_image::Gray;
-use polar_sensor::products::{StokesPlanes, stokes_planes_into};
+use polar_sensor::products::{StokesPlanes, simd_target, stokes_planes_into};
 use polar_sensor::{DemosaicMethod, Mosaic, MosaicSample};
 use rayon::prelude::*;
 
@@ -119,7 +119,8 @@ fn main() {
             .map(|(m, t)| format!("\"{}\": {:.6}", m.name(), t.as_secs_f64()))
             .collect();
         println!(
-            "{{\"width\": {w}, \"height\": {h}, \"threads\": {threads}, \"memcpy_gb_s\": {:.3}, \"stream_gb_s\": {:.3}, \"bytes_moved\": {moved}, \"bound_s\": {bound:.6}, \"seconds\": {{{}}}}}",
+            "{{\"width\": {w}, \"height\": {h}, \"threads\": {threads}, \"simd\": \"{}\", \"memcpy_gb_s\": {:.3}, \"stream_gb_s\": {:.3}, \"bytes_moved\": {moved}, \"bound_s\": {bound:.6}, \"seconds\": {{{}}}}}",
+            simd_target(),
             memcpy_bw / 1e9,
             stream_bw / 1e9,
             items.join(", ")
@@ -127,7 +128,8 @@ fn main() {
         return;
     }
     println!(
-        "{w}x{h}, {threads} threads, bandwidth (read+write) memcpy {:.2} GB/s, stream-scale {:.2} GB/s; bound uses the larger",
+        "{w}x{h}, {threads} threads, SIMD target {}, bandwidth (read+write) memcpy {:.2} GB/s, stream-scale {:.2} GB/s; bound uses the larger",
+        simd_target(),
         memcpy_bw / 1e9,
         stream_bw / 1e9
     );

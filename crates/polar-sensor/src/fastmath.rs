@@ -44,8 +44,9 @@ pub fn dolp_aolp(s0: f32, s1: f32, s2: f32) -> (f32, f32) {
     }
 }
 
-/// DoLP and AoLP of a row of Stokes values.
-#[inline]
+/// DoLP and AoLP of a row of Stokes values (`#[inline(always)]`: compiled for the
+/// SIMD target of the caller's dispatch, see `products`).
+#[inline(always)]
 pub fn dolp_aolp_row(s0: &[f32], s1: &[f32], s2: &[f32], dolp: &mut [f32], aolp: &mut [f32]) {
     let n = s0.len();
     let (s1, s2, dolp, aolp) = (&s1[..n], &s2[..n], &mut dolp[..n], &mut aolp[..n]);

@@ -5,10 +5,18 @@
 //! four polarizer images are never written to memory. Other methods demosaic
 //! first and then apply the same per-pixel formulas: `linear_stokes_from_quad` of
 //! `polar_optics::stokes`, and its `dolp`/`aolp` in the vectorisable form of [`crate::fastmath`].
+//!
+//! The row kernels are generic scalar code that the compiler vectorises; `pulp`
+//! compiles them once per SIMD target (x86-64 baseline, AVX2+FMA, AVX-512) and picks
+//! the best one the CPU has at run time ([`simd_target`] names it). The results are
+//! the same bit for bit on every target: the kernels use only `+ − × ÷ √` and
+//! selects, which IEEE 754 rounds identically at any vector width, and Rust never
+//! contracts `a * b + c` into an FMA on its own (a test compares the targets).
 
 use polar_image::{Gray, LinearStokesImage, PolarizerStack};
 use polar_optics::LinearStokesFit;
 use polar_optics::stokes::{imax, imin, linear_stokes_from_quad};
+use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
 
 use crate::demosaic::bilinear::bilinear_stokes_row;
@@ -131,10 +139,46 @@ impl StokesPlanes {
     }
 }
 
-/// DoLP and AoLP of one row of Stokes values (NaN where `S0 <= 0` or not finite).
+/// DoLP and AoLP of one row of Stokes values (NaN where `S0 <= 0` or not finite),
+/// on the best SIMD target of the CPU.
 #[inline]
 fn derived_row(s0: &[f32], s1: &[f32], s2: &[f32], d: &mut [f32], a: &mut [f32]) {
-    dolp_aolp_row(s0, s1, s2, d, a);
+    Arch::new().dispatch(DerivedRow {
+        stokes: [s0, s1, s2],
+        dolp: d,
+        aolp: a,
+    });
+}
+
+/// The work of [`derived_row`], as a `pulp` operation: `with_simd` is monomorphised
+/// per SIMD target and `#[inline(always)]`, so the row loop is compiled for each
+/// (a closure is not reliably inlined there and would stay baseline code).
+struct DerivedRow<'a> {
+    stokes: [&'a [f32]; 3],
+    dolp: &'a mut [f32],
+    aolp: &'a mut [f32],
+}
+
+impl WithSimd for DerivedRow<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let [s0, s1, s2] = self.stokes;
+        dolp_aolp_row(s0, s1, s2, self.dolp, self.aolp);
+    }
+}
+
+/// Name of the SIMD target the row kernels run on, detected at run time on this CPU
+/// (the build itself targets the x86-64 baseline unless `-C target-cpu` says otherwise).
+pub fn simd_target() -> &'static str {
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    match Arch::new() {
+        Arch::V4(_) => return "x86-64-v4 (AVX-512)",
+        Arch::V3(_) => return "x86-64-v3 (AVX2+FMA)",
+        _ => {}
+    }
+    "baseline (no runtime SIMD dispatch)"
 }
 
 /// Least-squares `S0, S1, S2, DoLP, AoLP` from images behind ideal polarizers at any
@@ -211,14 +255,49 @@ pub fn stokes_planes_into<T: MosaicSample>(
         *out = StokesPlanes::from_stack(&demosaic(raw, method)?);
         return Ok(());
     }
-    let src = raw.as_slice();
-    out.rows_mut()
-        .enumerate()
-        .for_each(|(y, [s0, s1, s2, d, a])| {
-            bilinear_stokes_row(src, w, h, y, [&mut *s0, &mut *s1, &mut *s2]);
-            derived_row(s0, s1, s2, d, a);
-        });
+    fused_bilinear(raw.as_slice(), w, h, out, Arch::new());
     Ok(())
+}
+
+/// The fused bilinear chain on planes of the mosaic size (`w, h >= 4`), one rayon task
+/// and one SIMD dispatch per row, each row's kernels compiled for `arch`.
+fn fused_bilinear<T: MosaicSample>(
+    src: &[T],
+    w: usize,
+    h: usize,
+    out: &mut StokesPlanes,
+    arch: Arch,
+) {
+    out.rows_mut().enumerate().for_each(|(y, planes)| {
+        arch.dispatch(FusedRow {
+            src,
+            w,
+            h,
+            y,
+            planes,
+        })
+    });
+}
+
+/// One output row `y` of [`fused_bilinear`] as a `pulp` operation (see [`DerivedRow`]):
+/// `planes` are the rows of `S0, S1, S2, DoLP, AoLP`.
+struct FusedRow<'a, T> {
+    src: &'a [T],
+    w: usize,
+    h: usize,
+    y: usize,
+    planes: [&'a mut [f32]; 5],
+}
+
+impl<T: MosaicSample> WithSimd for FusedRow<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let [s0, s1, s2, d, a] = self.planes;
+        bilinear_stokes_row(self.src, self.w, self.h, self.y, [s0, s1, s2]);
+        dolp_aolp_row(s0, s1, s2, d, a);
+    }
 }
 
 #[cfg(test)]
@@ -251,6 +330,54 @@ mod tests {
             assert_eq!(fused.s2, two_step.s2);
             assert_eq!(fused.dolp, two_step.dolp);
             assert_eq!(fused.aolp, two_step.aolp);
+        }
+    }
+
+    /// Every SIMD target this CPU has (baseline, AVX2+FMA, AVX-512) gives the same bits
+    /// as the baseline code on both bundled real frames, as u8 and as u16 mosaics.
+    /// Tolerance 0 (NaN compared by bits too): the kernels use only correctly rounded
+    /// IEEE operations and selects (see the module doc). On a CPU without AVX2 there is
+    /// nothing to compare.
+    #[test]
+    fn dispatch_targets_agree_bit_for_bit_on_real_frames() {
+        let mut archs = vec![Arch::Scalar];
+        #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+        {
+            archs.extend(pulp::x86::V3::try_new().map(Arch::V3));
+            archs.extend(pulp::x86::V4::try_new().map(Arch::V4));
+        }
+        let bits = |p: &StokesPlanes| -> Vec<u32> {
+            [&p.s0, &p.s1, &p.s2, &p.dolp, &p.aolp]
+                .iter()
+                .flat_map(|g| g.as_slice().iter().map(|v| v.to_bits()))
+                .collect()
+        };
+        fn run<T: MosaicSample>(raw: &Mosaic<T>, arch: Arch) -> StokesPlanes {
+            let (w, h) = raw.size();
+            let mut out = StokesPlanes::new(w, h);
+            fused_bilinear(raw.as_slice(), w, h, &mut out, arch);
+            out
+        }
+        for name in ["carps_IMX250MZR.png", "camera_IMX250MZR.png"] {
+            let path = format!(
+                "{}/../../tests/data/real/{name}",
+                env!("CARGO_MANIFEST_DIR")
+            );
+            let raw16 = polar_io::read_mosaic(&path).unwrap().image;
+            let (w, h) = raw16.size();
+            let raw8 = Mosaic::from_vec(w, h, raw16.as_slice().iter().map(|&v| v as u8).collect())
+                .unwrap();
+            let (base8, base16) = (run(&raw8, Arch::Scalar), run(&raw16, Arch::Scalar));
+            for &arch in &archs[1..] {
+                assert!(
+                    bits(&run(&raw8, arch)) == bits(&base8),
+                    "{name} u8 {arch:?}"
+                );
+                assert!(
+                    bits(&run(&raw16, arch)) == bits(&base16),
+                    "{name} u16 {arch:?}"
+                );
+            }
         }
     }
 

@@ -72,14 +72,17 @@ pub(crate) fn bilinear<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
 ///
 /// Per pixel, with the roles of [`bilinear_at`] (own sample `o`, left/right mean `h`,
 /// up/down mean `v`, diagonal mean `d`): `S0 = (o + h + v + d) / 2` and, from the
-/// layout `[[90, 45], [135, 0]]`, with `A = d − o` and `B = h − v`:
-/// `(S1, S2) = (A, B)` at (even row, even column), `(−B, −A)` at (even, odd),
-/// `(B, A)` at (odd, even), `(−A, −B)` at (odd, odd) — i.e. `S1 = I0 − I90`,
-/// `S2 = I45 − I135` of `linear_stokes_from_quad` (a test checks equality).
-/// Written as uniform loops over the row so that they vectorise.
+/// layout `[[90, 45], [135, 0]]`, with `P = d − o` and `Q = h − v`:
+/// `(S1, S2) = (P, Q)` at (even row, even column), `(−Q, −P)` at (even, odd),
+/// `(Q, P)` at (odd, even), `(−P, −Q)` at (odd, odd) — i.e. `S1 = I0 − I90`,
+/// `S2 = I45 − I135` of `linear_stokes_from_quad`, bit for bit (a test checks it;
+/// negation swaps the operands, so an exact zero stays `+0`). One uniform loop
+/// over the row with per-column selects, so that it vectorises; `#[inline(always)]`
+/// so that it is compiled for the SIMD target chosen by the caller's dispatch.
 ///
 /// Each output slice has the mosaic width; `w, h >= 4` (smaller frames use
 /// [`bilinear_at`] per pixel).
+#[inline(always)]
 pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
     src: &[T],
     w: usize,
@@ -91,16 +94,16 @@ pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
     let row = |r: usize| &src[r * w..(r + 1) * w];
     let (up, mid, dn) = (row(yc - 1), row(yc), row(yc + 1));
     let n = w - 2;
-    // Every slice re-cut to exactly `n` so that the loop has no bounds checks and vectorises.
+    // Every slice re-cut to exactly `n` so that the loop has no bounds checks.
     fn cut<T>(s: &[T], start: usize, n: usize) -> &[T] {
         &s[start..start + n]
     }
     let at = |s, start| cut(s, start, n);
     let (o, ml, mr, uc, dc) = (at(mid, 1), at(mid, 0), at(mid, 2), at(up, 1), at(dn, 1));
     let (ul, ur, dl, dr) = (at(up, 0), at(up, 2), at(dn, 0), at(dn, 2));
-    let (s0i, ai, bi) = (&mut s0[1..n + 1], &mut s1[1..n + 1], &mut s2[1..n + 1]);
+    let (s0i, s1i, s2i) = (&mut s0[1..=n], &mut s1[1..=n], &mut s2[1..=n]);
     let u = |s: &[T], i: usize| -> i32 { Into::<u32>::into(s[i]) as i32 };
-    let (s0i, ai, bi) = (&mut s0i[..n], &mut ai[..n], &mut bi[..n]);
+    let odd_row = yc & 1 == 1;
     for i in 0..n {
         // Sums of at most four 16-bit samples fit in i32; i32 -> f32 is one instruction.
         let own = u(o, i);
@@ -109,19 +112,14 @@ pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
         let dia = (u(ul, i) + u(ur, i) + u(dl, i) + u(dr, i) + 2) >> 2;
         let [o, h, v, d] = [own, hor, ver, dia].map(|r| r as f32);
         s0i[i] = 0.5 * (o + h + v + d);
-        ai[i] = d - o;
-        bi[i] = h - v;
-    }
-    // Interior column x = i + 1: pairs (odd x, even x) start at i = 0.
-    let odd_row = yc & 1 == 1;
-    for (a, b) in ai.chunks_exact_mut(2).zip(bi.chunks_exact_mut(2)) {
-        // Odd column: (−B, −A) on even rows, (−A, −B) on odd rows.
-        let (a0, b0) = (a[0], b[0]);
-        (a[0], b[0]) = if odd_row { (-a0, -b0) } else { (-b0, -a0) };
-        // Even column: (A, B) on even rows, (B, A) on odd rows.
-        if odd_row {
-            (a[1], b[1]) = (b[1], a[1]);
-        }
+        // Interior column x = i + 1.
+        let odd_col = i & 1 == 0;
+        let (p, q) = if odd_col {
+            (o - d, v - h)
+        } else {
+            (d - o, h - v)
+        };
+        (s1i[i], s2i[i]) = if odd_col != odd_row { (q, p) } else { (p, q) };
     }
     for s in [s0, s1, s2] {
         s[0] = s[1];
@@ -144,9 +142,11 @@ mod tests {
             bilinear_stokes_row(&src, w, h, y, [&mut a, &mut b, &mut c]);
             for x in 0..w {
                 let i = bilinear_at(&src, w, h, x, y).map(|v| v as f32);
+                let want = linear_stokes_from_quad(i[0], i[1], i[2], i[3]);
+                // Bit for bit: also the sign of zero.
                 assert_eq!(
-                    [a[x], b[x], c[x]],
-                    linear_stokes_from_quad(i[0], i[1], i[2], i[3]),
+                    [a[x], b[x], c[x]].map(f32::to_bits),
+                    want.map(f32::to_bits),
                     "({x},{y})"
                 );
             }
