@@ -1,5 +1,6 @@
 //! Renders a scene file and writes `stokes.exr`, the ground truth under `gt/`
-//! and `meta.json` (with the render time in `seconds`) into OUT_DIR.
+//! (with a medium also `gt/clear.exr` and `gt/transmission.exr`) and
+//! `meta.json` (with the render time in `seconds`) into OUT_DIR.
 //!
 //! `cargo run --release -p polar-render --example render_scene -- SCENE OUT_DIR [--spp N] [--model none|linear|full]`
 
@@ -63,6 +64,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     polar_io::write_gray8_png(out.join("gt/material.png"), &out_img.material)?;
     polar_io::write_gray8_png(out.join("gt/transparent.png"), &out_img.transparent)?;
+    for (name, image) in [
+        ("gt/clear.exr", &out_img.clear),
+        ("gt/transmission.exr", &out_img.transmission),
+    ] {
+        if let Some(image) = image {
+            polar_io::write_exr(out.join(name), image, polar_io::Y_CHANNEL)?;
+        }
+    }
     let meta = serde_json::json!({
         "width": scene.camera.width,
         "height": scene.camera.height,

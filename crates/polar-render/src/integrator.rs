@@ -18,10 +18,12 @@
 use crate::geometry::SurfaceHit;
 use crate::sampler::Sampler;
 use crate::scene::Vec3;
+use crate::tracking::Flight;
 use crate::transport::Transport;
 use crate::world::World;
-use polar_bsdf::Polarization;
+use polar_bsdf::{Bsdf, Polarization};
 use polar_optics::frame::{double_angle, rotate_rows};
+use polar_optics::scatter::PhaseFunction;
 use polar_optics::{Mueller, Stokes, rotate_stokes_basis, stokes_basis};
 
 /// Orthonormal shading frame: `z = n`, `x = stokes_basis(n)`, `y = z × x`.
@@ -80,8 +82,179 @@ fn spawn(hit: &SurfaceHit, d: &Vec3) -> Vec3 {
 enum Bounce {
     /// Camera ray or a delta lobe: emission counts fully.
     Specular,
-    /// A smooth lobe with solid-angle density `pdf` at point `p` with shading normal `n`.
-    Smooth { pdf: f64, p: Vec3, n: Vec3 },
+    /// A smooth lobe (or a phase function) with solid-angle density `pdf` at point
+    /// `p` with shading normal `n` (`None` in the medium).
+    Smooth { pdf: f64, p: Vec3, n: Option<Vec3> },
+}
+
+/// A scattering vertex: a surface point with its BSDF (in the shading frame), or
+/// a point in the medium with its phase function. Directions `wi` are world
+/// vectors toward where the light comes from.
+enum Vertex<'a> {
+    Surface {
+        hit: SurfaceHit,
+        bsdf: Bsdf,
+        frame: Frame,
+        /// Local direction toward the camera side.
+        wo: Vec3,
+    },
+    Medium {
+        p: Vec3,
+        phase: &'a PhaseFunction,
+        /// Propagation direction of the light leaving toward the camera side.
+        k_out: Vec3,
+    },
+}
+
+/// A sampled continuation of the path.
+struct Continuation {
+    /// World direction of the new ray.
+    wi: Vec3,
+    /// x axis of the input basis of `weight` (the next `path_x`).
+    in_x: Vec3,
+    /// Mueller matrix divided by the density (and the cosine, for surfaces).
+    weight: Mueller,
+    pdf: f64,
+    is_delta: bool,
+}
+
+impl Vertex<'_> {
+    fn p(&self) -> Vec3 {
+        match self {
+            Vertex::Surface { hit, .. } => hit.p,
+            Vertex::Medium { p, .. } => *p,
+        }
+    }
+
+    /// The normal light sampling may use (none in the medium).
+    fn normal(&self) -> Option<&Vec3> {
+        match self {
+            Vertex::Surface { frame, .. } => Some(&frame.z),
+            Vertex::Medium { .. } => None,
+        }
+    }
+
+    /// No light sampling at a vertex whose every lobe is a delta.
+    fn is_delta(&self) -> bool {
+        match self {
+            Vertex::Surface { bsdf, .. } => bsdf.is_delta(),
+            Vertex::Medium { .. } => false,
+        }
+    }
+
+    /// The x axis of the output basis of this vertex's matrices (light leaving along `-d`).
+    fn out_x(&self) -> Vec3 {
+        match self {
+            Vertex::Surface { frame, wo, .. } => frame.to_world(&stokes_basis(wo)),
+            Vertex::Medium { k_out, .. } => stokes_basis(k_out),
+        }
+    }
+
+    /// The Mueller matrix for light from `wi` (input basis [`Self::in_x`]), its
+    /// sampling density and the input basis x axis.
+    fn eval(&self, wi: &Vec3) -> (Mueller, f64, Vec3) {
+        match self {
+            Vertex::Surface {
+                bsdf, frame, wo, ..
+            } => {
+                let wi = frame.to_local(wi);
+                let in_x = frame.to_world(&stokes_basis(&-wi));
+                (bsdf.eval(wo, &wi), bsdf.pdf(wo, &wi), in_x)
+            }
+            Vertex::Medium { phase, k_out, .. } => (
+                phase.eval(&-wi, k_out),
+                phase.pdf(-wi.dot(k_out)),
+                stokes_basis(&-wi),
+            ),
+        }
+    }
+
+    /// Samples the direction the path continues in.
+    fn sample(&self, u: [f64; 3]) -> Option<Continuation> {
+        match self {
+            Vertex::Surface {
+                bsdf, frame, wo, ..
+            } => {
+                let s = bsdf.sample(wo, u)?;
+                Some(Continuation {
+                    wi: frame.to_world(&s.wi),
+                    in_x: frame.to_world(&stokes_basis(&-s.wi)),
+                    weight: s.weight,
+                    pdf: s.pdf,
+                    is_delta: s.is_delta,
+                })
+            }
+            Vertex::Medium { phase, k_out, .. } => {
+                // The density depends on k_in · k_out only: sampling about k_out gives k_in.
+                let (k_in, pdf) = phase.sample(k_out, [u[0], u[1]]);
+                (pdf > 0.0).then(|| Continuation {
+                    wi: -k_in,
+                    in_x: stokes_basis(&k_in),
+                    weight: phase.eval(&k_in, k_out) / pdf,
+                    pdf,
+                    is_delta: false,
+                })
+            }
+        }
+    }
+
+    /// Origin of a ray leaving the vertex along `wi` (off the surface).
+    fn spawn(&self, wi: &Vec3) -> Vec3 {
+        match self {
+            Vertex::Surface { hit, .. } => spawn(hit, wi),
+            Vertex::Medium { p, .. } => *p,
+        }
+    }
+}
+
+/// Next-event estimation at `vertex`: every sun, and one light with extent (MIS
+/// against the vertex's own sampling), each attenuated by the medium. The random
+/// numbers are drawn even at delta vertices, so the streams do not depend on it.
+/// `to_path` takes a matrix of this vertex into the path frame.
+fn next_event<R: Transport>(
+    world: &World,
+    vertex: &Vertex,
+    throughput: &R,
+    to_path: &impl Fn(&Mueller) -> R,
+    sampler: &mut Sampler,
+    sum: &mut Stokes,
+) {
+    let u_light = sampler.next_3d();
+    if vertex.is_delta() {
+        return;
+    }
+    let p = vertex.p();
+    let lights = world
+        .sun_samples()
+        .chain(world.sample_light(&p, vertex.normal(), u_light));
+    for ls in lights {
+        let (f, pdf, in_x) = vertex.eval(&ls.wi);
+        if f[(0, 0)] <= 0.0 {
+            continue;
+        }
+        let origin = vertex.spawn(&ls.wi);
+        let tmax = if ls.dist.is_finite() {
+            (ls.dist - (origin - p).norm()) * (1.0 - 1e-7)
+        } else {
+            f64::INFINITY
+        };
+        if !world.accel.unoccluded(&origin, &ls.wi, 0.0, tmax) {
+            continue;
+        }
+        let tr = world.transmittance(&origin, &ls.wi, tmax, sampler);
+        let w = if ls.is_delta {
+            1.0
+        } else {
+            power_heuristic(ls.pdf, pdf)
+        };
+        let le = into_frame(&ls.stokes, &-ls.wi, &in_x);
+        add::<R>(sum, &throughput.then(&to_path(&f)), &le, tr * w / ls.pdf);
+    }
+}
+
+/// `sum += t · le · w`.
+fn add<R: Transport>(sum: &mut Stokes, t: &R, le: &Stokes, w: f64) {
+    *sum += R::to_stokes(&t.apply(&R::from_stokes(le))) * w;
 }
 
 /// One path sample along the primary direction `d0`: the Stokes vector arriving
@@ -98,91 +271,82 @@ pub(crate) fn radiance<R: Transport>(
     let mut path_x = *x_ref;
     let mut sum = Stokes::zeros();
     let mut bounce = Bounce::Specular;
-    let mut add =
-        |t: &R, le: &Stokes, w: f64| sum += R::to_stokes(&t.apply(&R::from_stokes(le))) * w;
     for depth in 0..=settings.max_depth {
-        let Some(hit) = world.intersect(&o, &d) else {
-            if let Some(le) = world.environment() {
-                let w = match &bounce {
-                    Bounce::Specular => 1.0,
-                    Bounce::Smooth { pdf, n, .. } => {
-                        power_heuristic(*pdf, world.environment_pdf(n, &d))
-                    }
-                };
-                add(&throughput, &into_frame(&le, &-d, &path_x), w);
+        let hit = world.intersect(&o, &d);
+        let t_hit = hit.as_ref().map_or(f64::INFINITY, |h| (h.p - o).norm());
+        let vertex = match world.flight(&o, &d, t_hit, sampler) {
+            Flight::Scatter { t, weight, medium } => {
+                throughput = throughput.scaled(weight);
+                Vertex::Medium {
+                    p: o + t * d,
+                    phase: &medium.phase,
+                    k_out: -d,
+                }
             }
-            break;
-        };
-        if let Some(le) = world.emitted(&hit, &d) {
-            let w = match &bounce {
-                Bounce::Specular => 1.0,
-                Bounce::Smooth { pdf, p, .. } => power_heuristic(*pdf, world.area_pdf(&hit, p)),
-            };
-            add(&throughput, &into_frame(&le, &-d, &path_x), w);
-        }
-        let shape = &world.scene.shapes[hit.shape];
-        let Some(material) = shape.material.map(|m| &world.scene.materials[m].1) else {
-            break;
+            Flight::Pass { weight } => {
+                throughput = throughput.scaled(weight);
+                let Some(hit) = hit else {
+                    if let Some(le) = world.environment() {
+                        let w = match &bounce {
+                            Bounce::Specular => 1.0,
+                            Bounce::Smooth { pdf, n, .. } => {
+                                power_heuristic(*pdf, world.environment_pdf(n.as_ref(), &d))
+                            }
+                        };
+                        add(&mut sum, &throughput, &into_frame(&le, &-d, &path_x), w);
+                    }
+                    break;
+                };
+                if let Some(le) = world.emitted(&hit, &d) {
+                    let w = match &bounce {
+                        Bounce::Specular => 1.0,
+                        Bounce::Smooth { pdf, p, .. } => {
+                            power_heuristic(*pdf, world.area_pdf(&hit, p))
+                        }
+                    };
+                    add(&mut sum, &throughput, &into_frame(&le, &-d, &path_x), w);
+                }
+                let shape = &world.scene.shapes[hit.shape];
+                let Some(material) = shape.material.map(|m| &world.scene.materials[m].1) else {
+                    break;
+                };
+                if depth == settings.max_depth {
+                    break;
+                }
+                let frame = Frame::new(shading_normal(&hit, &d, material.label()));
+                Vertex::Surface {
+                    bsdf: material.bsdf(hit.uv),
+                    wo: frame.to_local(&-d),
+                    frame,
+                    hit,
+                }
+            }
         };
         if depth == settings.max_depth {
             break;
         }
-        let bsdf = material.bsdf(hit.uv);
-        let frame = Frame::new(shading_normal(&hit, &d, material.label()));
-        let wo_w = -d;
-        let wo = frame.to_local(&wo_w);
-        // The one rotation of this vertex: BSDF output basis into the path frame.
-        let out_rotation = (R::MODEL != Polarization::None)
-            .then(|| double_angle(&wo_w, &frame.to_world(&stokes_basis(&wo)), &path_x));
+        // The one rotation of this vertex: its output basis into the path frame.
+        let out_rotation =
+            (R::MODEL != Polarization::None).then(|| double_angle(&-d, &vertex.out_x(), &path_x));
         let to_path = |m: &Mueller| match out_rotation {
             Some(r) => R::from_mueller(&rotate_rows(m, r)),
             None => R::from_mueller(m),
         };
-        let in_basis = |wi: &Vec3| frame.to_world(&stokes_basis(&-wi));
+        next_event(world, &vertex, &throughput, &to_path, sampler, &mut sum);
 
-        // Next-event estimation: every sun, and one light with extent (none when
-        // every lobe is a delta; the random numbers are drawn anyway, so that the
-        // sample streams do not depend on it).
-        let u_light = sampler.next_3d();
-        let lights = (!bsdf.is_delta())
-            .then(|| (world.sun_samples()).chain(world.sample_light(&hit.p, &frame.z, u_light)));
-        for ls in lights.into_iter().flatten() {
-            let wi = frame.to_local(&ls.wi);
-            let f = bsdf.eval(&wo, &wi);
-            if f[(0, 0)] <= 0.0 {
-                continue;
-            }
-            let origin = spawn(&hit, &ls.wi);
-            let tmax = if ls.dist.is_finite() {
-                (ls.dist - (origin - hit.p).norm()) * (1.0 - 1e-7)
-            } else {
-                f64::INFINITY
-            };
-            if world.accel.unoccluded(&origin, &ls.wi, 0.0, tmax) {
-                let w = if ls.is_delta {
-                    1.0
-                } else {
-                    power_heuristic(ls.pdf, bsdf.pdf(&wo, &wi))
-                };
-                let le = into_frame(&ls.stokes, &-ls.wi, &in_basis(&wi));
-                add(&throughput.then(&to_path(&f)), &le, w / ls.pdf);
-            }
-        }
-
-        // Continue the path by sampling the BSDF.
-        let Some(s) = bsdf.sample(&wo, sampler.next_3d()) else {
+        // Continue the path by sampling the BSDF or the phase function.
+        let Some(s) = vertex.sample(sampler.next_3d()) else {
             break;
         };
-        let wi_w = frame.to_world(&s.wi);
         throughput = throughput.then(&to_path(&s.weight));
-        path_x = in_basis(&s.wi);
+        path_x = s.in_x;
         bounce = if s.is_delta {
             Bounce::Specular
         } else {
             Bounce::Smooth {
                 pdf: s.pdf,
-                p: hit.p,
-                n: frame.z,
+                p: vertex.p(),
+                n: vertex.normal().copied(),
             }
         };
         if depth >= RR_DEPTH {
@@ -192,8 +356,8 @@ pub(crate) fn radiance<R: Transport>(
             }
             throughput = throughput.scaled(1.0 / q);
         }
-        o = spawn(&hit, &wi_w);
-        d = wi_w;
+        o = vertex.spawn(&s.wi);
+        d = s.wi;
     }
     sum
 }

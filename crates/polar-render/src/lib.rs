@@ -13,14 +13,17 @@
 mod camera;
 mod geometry;
 mod integrator;
+pub mod medium;
 mod render;
 pub mod sampler;
 pub mod scene;
 pub mod scene_file;
 pub mod shapes;
+mod tracking;
 pub mod transport;
 mod world;
 
+pub use medium::{DensityGrid, Medium};
 pub use polar_bsdf::{Material, Polarization};
 pub use render::{RenderOptions, RenderOutput, render, required_model};
 pub use scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, TriangleMesh};

@@ -38,16 +38,24 @@ pub struct RenderOutput {
     pub material: Gray<u8>,
     /// 255 on transparent objects, else 0.
     pub transparent: Gray<u8>,
+    /// S0 of the same view rendered without the participating medium (same
+    /// seed and samples); `None` when the scene has no medium.
+    pub clear: Option<Gray<f32>>,
+    /// Transmittance `exp(−∫ σ_t ds)` of the medium along each pixel's central ray
+    /// up to its first surface (to the medium's exit if none), computed exactly;
+    /// `None` when the scene has no medium.
+    pub transmission: Option<Gray<f32>>,
     /// The transport model used.
     pub model: Polarization,
-    /// Wall-clock seconds of the render (BVH build included).
+    /// Wall-clock seconds of the render (BVH build included; the medium-free
+    /// render behind `clear` excluded).
     pub seconds: f64,
     /// Samples per pixel.
     pub spp: u32,
 }
 
 /// The cheapest exact model for `scene`: the maximum over the materials on its
-/// shapes and the polarization of its emitters.
+/// shapes, the polarization of its emitters and its medium's phase function.
 pub fn required_model(scene: &Scene) -> Polarization {
     let materials = scene
         .shapes
@@ -64,9 +72,11 @@ pub fn required_model(scene: &Scene) -> Polarization {
             emission_polarization(&e.polarization)
         }
     });
+    let medium = scene.medium.iter().map(|m| m.polarization());
     materials
         .chain(emitters)
         .chain(lights)
+        .chain(medium)
         .max()
         .unwrap_or(Polarization::None)
 }
@@ -85,6 +95,8 @@ struct GroundTruth {
     normal: [f32; 3],
     depth: f32,
     label: u8,
+    /// Transmittance of the medium along the central ray (1 without a medium).
+    transmission: f32,
 }
 
 /// Renders `scene` with the cheapest exact transport (or `opts.force_model`),
@@ -105,13 +117,38 @@ pub fn render(
         });
     }
     let start = Instant::now();
+    let tiles = render_with(scene, model, progress);
+    let seconds = start.elapsed().as_secs_f64();
+    let mut out = assemble(scene, tiles, model, seconds);
+    if scene.medium.is_some() {
+        let clear_scene = Scene {
+            medium: None,
+            ..scene.clone()
+        };
+        let clear_model = opts.force_model.unwrap_or(required_model(&clear_scene));
+        let clear = assemble(
+            &clear_scene,
+            render_with(&clear_scene, clear_model, progress),
+            clear_model,
+            0.0,
+        );
+        out.clear = Some(clear.stokes.channel(0));
+    }
+    Ok(out)
+}
+
+/// Renders the tiles of a validated scene with transport `model`.
+fn render_with(
+    scene: &Scene,
+    model: Polarization,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Vec<TileResult> {
     let world = World::new(scene);
-    let tiles = match model {
+    match model {
         Polarization::None => render_tiles::<Scalar>(&world, progress),
         Polarization::Linear => render_tiles::<Linear>(&world, progress),
         Polarization::Full => render_tiles::<Full>(&world, progress),
-    };
-    Ok(assemble(scene, tiles, model, start.elapsed().as_secs_f64()))
+    }
 }
 
 fn render_tiles<R: Transport>(
@@ -170,8 +207,17 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
 /// First-hit ground truth along the ray through the pixel centre.
 fn ground_truth(world: &World, x: usize, y: usize) -> GroundTruth {
     let d = world.camera.direction(x as f64 + 0.5, y as f64 + 0.5);
-    let Some(hit) = world.intersect(&world.camera.position, &d) else {
-        return GroundTruth::default();
+    let o = world.camera.position;
+    let hit = world.intersect(&o, &d);
+    let t_hit = hit.as_ref().map_or(f64::INFINITY, |h| (h.p - o).norm());
+    let transmission = world.scene.medium.as_ref().map_or(1.0, |m| {
+        (-crate::tracking::optical_depth(m, &o, &d, t_hit)).exp() as f32
+    });
+    let Some(hit) = hit else {
+        return GroundTruth {
+            transmission,
+            ..GroundTruth::default()
+        };
     };
     let shape = &world.scene.shapes[hit.shape];
     let n = if hit.ns.dot(&d) > 0.0 {
@@ -188,6 +234,7 @@ fn ground_truth(world: &World, x: usize, y: usize) -> GroundTruth {
         normal: [n.x as f32, n.y as f32, n.z as f32],
         depth: world.camera.depth(&hit.p) as f32,
         label,
+        transmission,
     }
 }
 
@@ -203,6 +250,7 @@ fn assemble(
     let mut depth = Gray::<f32>::new(w, h);
     let mut material = Gray::<u8>::new(w, h);
     let mut transparent = Gray::<u8>::new(w, h);
+    let mut transmission = Gray::<f32>::new(w, h);
     for t in tiles {
         for (i, (s, g)) in t.stokes.iter().zip(&t.gt).enumerate() {
             let p = (t.y0 + i / t.w) * w + t.x0 + i % t.w;
@@ -211,6 +259,7 @@ fn assemble(
             depth.pixels_mut()[p] = [g.depth];
             material.pixels_mut()[p] = [g.label];
             transparent.pixels_mut()[p] = [if g.label == 3 { 255 } else { 0 }];
+            transmission.pixels_mut()[p] = [g.transmission];
         }
     }
     RenderOutput {
@@ -219,6 +268,8 @@ fn assemble(
         depth,
         material,
         transparent,
+        clear: None,
+        transmission: scene.medium.is_some().then_some(transmission),
         model,
         seconds,
         spp: scene.settings.spp,

@@ -6,6 +6,7 @@
 //! `S0` in the implicit frame `x = polar_optics::stokes_basis(k)` of the
 //! propagation direction `k` (as Mitsuba 3 does for its polarized emitters).
 
+use crate::medium::Medium;
 use crate::{Error, Material};
 use nalgebra::{Matrix4, Vector3};
 use std::path::Path;
@@ -176,6 +177,8 @@ pub struct Scene {
     pub shapes: Vec<Shape>,
     /// Environment and sun lights.
     pub lights: Vec<Light>,
+    /// The participating medium, if any (at most one).
+    pub medium: Option<Medium>,
     /// Sensor parameters, kept verbatim for the sensor model (polar-sensor).
     pub sensor: Option<toml::Table>,
 }
@@ -189,6 +192,7 @@ impl Scene {
             materials: Vec::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
+            medium: None,
             sensor: None,
         }
     }
@@ -204,7 +208,7 @@ impl Scene {
 const BUILT_IN_CODE: &str = "<scene built in code>";
 
 impl Scene {
-    /// Checks every value (camera, settings, materials, shapes, lights); errors
+    /// Checks every value (camera, settings, materials, shapes, lights, medium); errors
     /// name the key and the reason.
     pub fn validate(&self) -> Result<(), Error> {
         self.validate_as(Path::new(BUILT_IN_CODE))
@@ -301,6 +305,10 @@ impl Scene {
                 "lights".into(),
                 format!("{environments} environment lights; at most one is allowed"),
             );
+        }
+        if let Some(m) = &self.medium {
+            m.validate()
+                .or_else(|(k, r)| bad(format!("medium.{k}"), r))?;
         }
         Ok(())
     }

@@ -3,8 +3,10 @@
 //! errors) and every error names the file, the key and the reason.
 
 use crate::Error;
-use crate::scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape};
+use crate::medium::{DensityGrid, Medium};
+use crate::scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, Vec3};
 use crate::shapes;
+use polar_optics::scatter::PhaseFunction;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -27,7 +29,46 @@ struct SceneFile {
     shapes: Vec<ShapeDesc>,
     #[serde(default)]
     lights: Vec<LightDesc>,
+    medium: Option<MediumDesc>,
     sensor: Option<toml::Table>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MediumDesc {
+    bounds_min: [f64; 3],
+    bounds_max: [f64; 3],
+    sigma_s: f64,
+    #[serde(default)]
+    sigma_a: f64,
+    phase: PhaseDesc,
+    density: Option<DensityDesc>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+enum PhaseDesc {
+    Rayleigh {},
+    Hg {
+        g: f64,
+        #[serde(default = "one")]
+        depolarization: f64,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// A density grid (`resolution` + `values`) or a height fog (`height_falloff`,
+/// optional `up` and `resolution`); which keys go together is checked in [`density`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DensityDesc {
+    resolution: Option<[usize; 3]>,
+    values: Option<Vec<f64>>,
+    height_falloff: Option<f64>,
+    up: Option<[f64; 3]>,
 }
 
 #[derive(Deserialize)]
@@ -227,8 +268,97 @@ fn build(desc: SceneFile, file: &Path, base: &Path) -> Result<Scene, Error> {
             },
         });
     }
+    scene.medium = desc.medium.map(|m| medium(m, file)).transpose()?;
     scene.validate_as(file)?;
     Ok(scene)
+}
+
+fn medium(m: MediumDesc, file: &Path) -> Result<Medium, Error> {
+    let phase = match m.phase {
+        PhaseDesc::Rayleigh {} => Ok(PhaseFunction::Rayleigh),
+        PhaseDesc::Hg { g, depolarization } => PhaseFunction::henyey_greenstein(g, depolarization),
+    }
+    .map_err(|e| {
+        let key = match &e {
+            polar_optics::OpticsError::OutOfRange { name, .. } => format!("medium.phase.{name}"),
+            _ => "medium.phase".into(),
+        };
+        invalid(file, key, e.to_string())
+    })?;
+    let (lo, hi) = (Vec3::from(m.bounds_min), Vec3::from(m.bounds_max));
+    let density = m.density.map(|d| density(d, &lo, &hi, file)).transpose()?;
+    Ok(Medium {
+        bounds_min: lo,
+        bounds_max: hi,
+        sigma_s: m.sigma_s,
+        sigma_a: m.sigma_a,
+        phase,
+        density,
+    })
+}
+
+/// Largest height-fog grid (cells) a scene file may ask for (128 MiB of values).
+const MAX_FOG_CELLS: usize = 1 << 24;
+
+/// The grid of `[medium.density]`: given values, or a height fog sampled on a grid.
+fn density(d: DensityDesc, lo: &Vec3, hi: &Vec3, file: &Path) -> Result<DensityGrid, Error> {
+    let key = |k: &str| format!("medium.density.{k}");
+    match (d.values, d.height_falloff) {
+        (Some(values), None) => {
+            if d.up.is_some() {
+                return Err(invalid(
+                    file,
+                    key("up"),
+                    "only for a height fog (`height_falloff`)",
+                ));
+            }
+            let resolution = d
+                .resolution
+                .ok_or_else(|| invalid(file, key("resolution"), "required with `values`"))?;
+            Ok(DensityGrid { resolution, values })
+        }
+        (None, Some(falloff)) => {
+            if !(falloff > 0.0 && falloff.is_finite()) {
+                return Err(invalid(
+                    file,
+                    key("height_falloff"),
+                    format!("must be positive and finite, got {falloff}"),
+                ));
+            }
+            let up = Vec3::from(d.up.unwrap_or([0.0, 1.0, 0.0]));
+            if !(up.iter().all(|c| c.is_finite()) && up.norm() > 0.0) {
+                return Err(invalid(
+                    file,
+                    key("up"),
+                    format!("must be finite and non-zero, got {:?}", up.as_slice()),
+                ));
+            }
+            if let Some(r) = d.resolution {
+                let cells = r.iter().try_fold(1_usize, |a, &n| a.checked_mul(n));
+                if r.contains(&0) || cells.is_none_or(|c| c > MAX_FOG_CELLS) {
+                    return Err(invalid(
+                        file,
+                        key("resolution"),
+                        format!("{r:?}: needs 1 to {MAX_FOG_CELLS} cells, at least 1 per axis"),
+                    ));
+                }
+            }
+            if !(lo.iter().chain(hi.iter()).all(|c| c.is_finite())) {
+                return Err(invalid(file, "medium.bounds_min", "bounds must be finite"));
+            }
+            Ok(DensityGrid::height_fog(lo, hi, &up, falloff, d.resolution))
+        }
+        (Some(_), Some(_)) => Err(invalid(
+            file,
+            key("values"),
+            "give either `values` (a grid) or `height_falloff` (a height fog), not both",
+        )),
+        (None, None) => Err(invalid(
+            file,
+            "medium.density",
+            "needs `resolution` and `values`, or `height_falloff`",
+        )),
+    }
 }
 
 /// Keys each shape type accepts besides the common ones.

@@ -3,7 +3,9 @@
 
 use crate::camera::PinholeCamera;
 use crate::geometry::{Accel, SurfaceHit};
+use crate::sampler::Sampler;
 use crate::scene::{Emission, Light, Scene, Vec3};
+use crate::tracking::{self, Flight};
 use polar_optics::Stokes;
 use std::f64::consts::PI;
 
@@ -48,6 +50,14 @@ pub(crate) struct World<'a> {
     environment: Option<Emission>,
     /// Index in `lights` of each emissive shape (for MIS when a BSDF ray hits it).
     area_index: Vec<Option<usize>>,
+}
+
+/// Uniform direction on the sphere (for environment light seen from a medium point).
+fn sphere_direction(u: [f64; 2]) -> Vec3 {
+    let z = 1.0 - 2.0 * u[0];
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u[1];
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
 /// Cosine-weighted direction about `n` (Malley's method), in world space.
@@ -121,6 +131,23 @@ impl<'a> World<'a> {
         Some(self.accel.surface(self.scene, hit, o, d))
     }
 
+    /// The first scattering event along `o + t d` before `t_max`, or passing through
+    /// (always `Pass` with weight 1, drawing no random numbers, without a medium).
+    pub fn flight(&self, o: &Vec3, d: &Vec3, t_max: f64, sampler: &mut Sampler) -> Flight<'a> {
+        match &self.scene.medium {
+            Some(m) => tracking::flight(m, o, d, t_max, sampler),
+            None => Flight::Pass { weight: 1.0 },
+        }
+    }
+
+    /// Transmittance (or its unbiased estimate) of the segment `o + t d`, `t < t_max`.
+    pub fn transmittance(&self, o: &Vec3, d: &Vec3, t_max: f64, sampler: &mut Sampler) -> f64 {
+        self.scene
+            .medium
+            .as_ref()
+            .map_or(1.0, |m| tracking::transmittance(m, o, d, t_max, sampler))
+    }
+
     /// Environment radiance (Stokes in the implicit frame), if there is an environment.
     pub fn environment(&self) -> Option<Stokes> {
         self.environment.map(|e| e.stokes())
@@ -137,9 +164,14 @@ impl<'a> World<'a> {
     }
 
     /// Density (solid angle, with the light choice) with which [`Self::sample_light`]
-    /// would return direction `wi` from a point with shading normal `n` toward the environment.
-    pub fn environment_pdf(&self, n: &Vec3, wi: &Vec3) -> f64 {
-        self.pick_probability() * n.dot(wi).max(0.0) / PI
+    /// would return direction `wi` toward the environment from a surface point with
+    /// shading normal `n` (cosine-weighted) or a medium point (`None`, uniform).
+    pub fn environment_pdf(&self, n: Option<&Vec3>, wi: &Vec3) -> f64 {
+        self.pick_probability()
+            * match n {
+                Some(n) => n.dot(wi).max(0.0) / PI,
+                None => 0.25 / PI,
+            }
     }
 
     /// Density of reaching `hit` on an emissive shape from `from` by light sampling.
@@ -170,8 +202,9 @@ impl<'a> World<'a> {
     }
 
     /// Samples one light with extent (environment or emissive shape) as seen from
-    /// `p` with shading normal `n` (visibility not tested); suns are in [`Self::sun_samples`].
-    pub fn sample_light(&self, p: &Vec3, n: &Vec3, u: [f64; 3]) -> Option<LightSample> {
+    /// `p` with shading normal `n` (`None` in a medium; visibility not tested);
+    /// suns are in [`Self::sun_samples`].
+    pub fn sample_light(&self, p: &Vec3, n: Option<&Vec3>, u: [f64; 3]) -> Option<LightSample> {
         if self.lights.is_empty() {
             return None;
         }
@@ -179,7 +212,10 @@ impl<'a> World<'a> {
         let index = ((u[0] * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
         match &self.lights[index] {
             LightRef::Environment(e) => {
-                let wi = cosine_direction(n, [u[1], u[2]]);
+                let wi = match n {
+                    Some(n) => cosine_direction(n, [u[1], u[2]]),
+                    None => sphere_direction([u[1], u[2]]),
+                };
                 let pdf = self.environment_pdf(n, &wi);
                 (pdf > 0.0).then(|| LightSample {
                     wi,

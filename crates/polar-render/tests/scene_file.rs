@@ -133,3 +133,112 @@ fn every_example_scene_loads() {
         assert!(!scene.shapes.is_empty(), "{} has no shapes", f.display());
     }
 }
+
+const MEDIUM: &str = "[medium]\nbounds_min = [-1.0, -1.0, -1.0]\nbounds_max = [1.0, 1.0, 1.0]\n";
+
+#[test]
+fn medium_keys_are_read() {
+    let scene = parse(&format!(
+        "{MEDIUM}sigma_s = 0.5\nphase = {{ type = \"hg\", g = 0.6, depolarization = 0.5 }}\n\
+         density = {{ resolution = [2, 1, 1], values = [0.0, 2.0] }}\n"
+    ))
+    .expect("scene");
+    let m = scene.medium.expect("medium");
+    assert_eq!((m.sigma_s, m.sigma_a), (0.5, 0.0));
+    assert_eq!(m.density.expect("grid").values, vec![0.0, 2.0]);
+    let fog = parse(&format!(
+        "{MEDIUM}sigma_s = 0.5\nphase = {{ type = \"rayleigh\" }}\n\
+         density = {{ height_falloff = 0.5, up = [0.0, 0.0, 1.0] }}\n"
+    ))
+    .expect("fog")
+    .medium
+    .expect("medium")
+    .density
+    .expect("grid");
+    // Along z only; density 1 at the bottom centre, e^{-h/H} above.
+    assert_eq!(fog.resolution, [1, 1, 64]);
+    let first = (-(1.0 / 64.0) / 0.5_f64).exp();
+    assert!((fog.values[0] - first).abs() < 1e-12 && fog.values[63] < fog.values[0]);
+}
+
+#[test]
+fn bad_medium_values_are_named() {
+    let rayleigh = "phase = { type = \"rayleigh\" }\n";
+    let cases = [
+        (
+            format!("{MEDIUM}sigma_s = -0.5\n{rayleigh}"),
+            "medium.sigma_s",
+            ">= 0",
+        ),
+        (
+            format!("{MEDIUM}sigma_s = 0.5\nsigma_a = nan\n{rayleigh}"),
+            "medium.sigma_a",
+            "finite",
+        ),
+        (
+            format!(
+                "[medium]\nbounds_min = [0.0, 0.0, 0.0]\nbounds_max = [1.0, 0.0, 1.0]\nsigma_s = 1.0\n{rayleigh}"
+            ),
+            "medium.bounds_max",
+            "must exceed bounds_min",
+        ),
+        (
+            format!("{MEDIUM}sigma_s = 1.0\nphase = {{ type = \"hg\", g = 1.0 }}\n"),
+            "medium.phase.g",
+            "(-1, 1)",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\n{rayleigh}density = {{ resolution = [2, 2, 2], values = [1.0] }}\n"
+            ),
+            "medium.density.values",
+            "1 values for resolution [2, 2, 2]",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\n{rayleigh}density = {{ resolution = [2, 1, 1], values = [1.0, -1.0] }}\n"
+            ),
+            "medium.density.values",
+            "values[1] = -1",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\n{rayleigh}density = {{ resolution = [0, 1, 1], values = [] }}\n"
+            ),
+            "medium.density.resolution",
+            "at least 1 cell",
+        ),
+        (
+            format!("{MEDIUM}sigma_s = 1.0\n{rayleigh}density = {{ height_falloff = 0.0 }}\n"),
+            "medium.density.height_falloff",
+            "positive",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\n{rayleigh}density = {{ height_falloff = 1.0, values = [1.0] }}\n"
+            ),
+            "medium.density.values",
+            "not both",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\n{rayleigh}density = {{ height_falloff = 1.0, resolution = [100000, 100000, 1] }}\n"
+            ),
+            "medium.density.resolution",
+            "cells",
+        ),
+        (
+            format!("{MEDIUM}sigma_s = 1.0\n{rayleigh}sigma_t = 2.0\n"),
+            "sigma_t",
+            "unknown field",
+        ),
+        (
+            format!("{MEDIUM}sigma_s = 1.0\nphase = {{ type = \"rayleigh\", g = 0.5 }}\n"),
+            "g",
+            "unknown field",
+        ),
+    ];
+    for (body, key, reason) in cases {
+        assert_names(parse(&body).unwrap_err(), key, reason);
+    }
+}
