@@ -40,7 +40,12 @@ fn hg(g: f64, d: f64) -> PhaseFunction {
 }
 
 fn mie(x: f64, n: f64, k: f64) -> PhaseFunction {
-    PhaseFunction::Mie(Arc::new(MieTable::new(x, Complex64::new(n, k)).unwrap()))
+    let p = PhaseFunction::mie(x, Complex64::new(n, k)).unwrap();
+    assert_eq!(
+        p,
+        PhaseFunction::Mie(Arc::new(MieTable::new(x, Complex64::new(n, k)).unwrap()))
+    );
+    p
 }
 
 /// Every configuration under test, by name, including the extreme asymmetries.

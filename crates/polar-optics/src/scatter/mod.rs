@@ -118,6 +118,12 @@ impl PhaseFunction {
         Ok(p)
     }
 
+    /// A Mie phase function for size parameter `x` and relative index `m` (table built
+    /// once, see [`MieTable::new`] for the errors and the cost).
+    pub fn mie(x: f64, m: num_complex::Complex64) -> Result<Self, OpticsError> {
+        Ok(Self::Mie(Arc::new(MieTable::new(x, m)?)))
+    }
+
     /// Checks the parameters of a variant built directly.
     pub fn validate(&self) -> Result<(), OpticsError> {
         match *self {
