@@ -5,7 +5,7 @@ both on the same number of threads (default 2), on the cross-check scenes.
 For each scene and several spp values, both renderers are timed and their
 error measured against a converged Mitsuba reference:
 
-    error = S0 relative RMSE over the sphere pixels (as in crosscheck.py),
+    error = S0 relative RMSE over the object pixels (as in crosscheck.py),
 
 with the reference's own noise removed: the reference is the mean R of two
 independent renders R1, R2, and E|X - T|^2 = E|X - R|^2 - E|R1 - R2|^2 / 4
@@ -58,7 +58,8 @@ class Reference:
     def __init__(self, mi, refs, name, spp):
         r1, r2 = (scenes.read_stokes_exr(mi, render_refs.ensure_reference(mi, refs / f"seed{s}", name, spp, s))
                   for s in (0, 1))
-        self.mask = scenes.sphere_mask()
+        self.mask = scenes.object_mask(name)
+        self.pixels = self.mask.size
         self.s0 = 0.5 * (r1[..., 0] + r2[..., 0])[self.mask]
         self.noise_mse = float(np.mean((r1[..., 0] - r2[..., 0])[self.mask] ** 2)) / 4
         self.stokes = 0.5 * (r1 + r2)
@@ -142,16 +143,18 @@ def main():
         gaps = ours.missing(args.scenes)
         why = "missing " + ", ".join(gaps) if gaps else None
         exe = None if gaps else ours.build()
-    pixels = scenes.WIDTH * scenes.HEIGHT
     results = {}
     references = {n: Reference(mi, refs, n, args.ref_spp or scenes.REFERENCE_SPP[n]) for n in args.scenes}
     print(f"\n{'scene':<16}{'renderer':<10}{'spp':>7}{'seconds':>10}{'Msamples/s':>12}{'S0 error':>13}")
     for name, ref in references.items():
         res = {"floor": ref.floor(), "mitsuba": bench_mitsuba(mi, name, args.spp, ref)}
-        print_rows(name, "mitsuba", res["mitsuba"], pixels)
+        print_rows(name, "mitsuba", res["mitsuba"], ref.pixels)
         if exe is not None:
-            res["ours"], res["ours_timing"] = bench_ours(exe, name, args.spp, ref, args.out, args.threads)
-            print_rows(name, "ours", res["ours"], pixels)
+            try:
+                res["ours"], res["ours_timing"] = bench_ours(exe, name, args.spp, ref, args.out, args.threads)
+                print_rows(name, "ours", res["ours"], ref.pixels)
+            except ours.RenderFailed as err:
+                print(f"{name}: OUR RENDERER FAILED, Mitsuba only:\n{err}")
         for label in ("mitsuba", "ours"):
             if label in res:
                 res["c_" + label] = fit_c(res[label])
@@ -163,8 +166,9 @@ def main():
     if exe is not None:
         print("\ntime-to-equal-error, Mitsuba time / our time (fit error = c / sqrt(t)):")
         for n, r in results.items():
-            print(f"  {n:<16}{r['speedup']:6.2f}x   (our timing: {r['ours_timing']})")
-        speedups = [r["speedup"] for r in results.values() if np.isfinite(r["speedup"])]
+            if "speedup" in r:
+                print(f"  {n:<16}{r['speedup']:6.2f}x   (our timing: {r['ours_timing']})")
+        speedups = [r["speedup"] for r in results.values() if np.isfinite(r.get("speedup", np.nan))]
         if speedups:
             print(f"  {'geometric mean':<16}{np.exp(np.mean(np.log(speedups))):6.2f}x")
     meta = {"threads": args.threads, "spp": args.spp, "mitsuba": render_refs.scenes_version(), "scenes": results}

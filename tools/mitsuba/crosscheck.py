@@ -1,16 +1,18 @@
 #!/usr/bin/env python3
-"""Cross-checks our renderer against Mitsuba 3 on the four scenes of scenes.md.
+"""Cross-checks our renderer against Mitsuba 3 on the scenes of scenes.md
+(four surface scenes and `haze`, a participating medium).
 
 For each scene: the Mitsuba reference (rendered, or reused from --refs), our
 render (the polar-render `render_scene` example, or OURS/<scene>/stokes.exr
-with --ours), the figures of scenes.md over the sphere pixels
+with --ours), the figures of scenes.md over the object pixels (the sphere's;
+for `haze` the medium box's)
 
     mean |dDoLP| <= 0.01, mean |dAoLP| <= 2 deg where DoLP > 0.05, S0 rel. RMSE <= 2%
 
 a table, and OUT/<scene>.png (ours | Mitsuba | difference for S0, DoLP, AoLP).
-Exit status: 0 all pass, 1 a figure fails, 2 our renderer is not available
-(0 instead with --ours-only-if-available, which then only renders the
-references and says so).
+Exit status: 0 all pass, 1 a figure fails or our renderer refuses a scene
+file (its error is printed), 2 our renderer is not available (0 instead with
+--ours-only-if-available, which then only renders the references and says so).
 
     tools/.venv/bin/python tools/mitsuba/crosscheck.py OUT [--refs DIR] [--ours DIR]
         [--spp-ours N] [--threads 2] [--ours-only-if-available]
@@ -109,6 +111,9 @@ def print_table(rows):
     print(f"\n{'scene':<16}{'mean|dDoLP|':>12}{'mean|dAoLP| deg':>17}{'(pixels)':>10}{'S0 rel RMSE':>13}  result")
     print(f"{'limit':<16}{lim['dolp_mae']:>12.4f}{lim['aolp_mae_deg']:>17.2f}{'':>10}{100 * lim['s0_rel_rmse']:>12.2f}%")
     for name, f in rows:
+        if f is None:
+            print(f"{name:<16}{'our renderer failed (see above)':>52}  FAIL")
+            continue
         verdict = "pass" if scenes.passes(f) else "FAIL"
         print(f"{name:<16}{f['dolp_mae']:>12.4f}{f['aolp_mae_deg']:>17.2f}{f['aolp_pixels']:>10}"
               f"{100 * f['s0_rel_rmse']:>12.2f}%  {verdict}")
@@ -126,18 +131,23 @@ def main():
               "nothing was compared.")
         sys.exit(0 if args.ours_only_if_available else 2)
     args.out.mkdir(parents=True, exist_ok=True)
-    mask = scenes.sphere_mask()
     rows = []
     for name in args.scenes:
-        mine = get_ours(name)
+        try:
+            mine = get_ours(name)
+        except ours.RenderFailed as err:
+            print(f"\n{name}: OUR RENDERER FAILED on {ours.scene_file(name).relative_to(scenes.REPO)}:\n{err}")
+            rows.append((name, None))
+            continue
         if mine.shape != reference[name].shape:
             raise SystemExit(f"{name}: our image is {mine.shape[:2]}, Mitsuba's {reference[name].shape[:2]}")
+        mask = scenes.object_mask(name)
         figures = scenes.compare(mine, reference[name], mask)
         comparison_png(args.out / f"{name}.png", name, mine, reference[name], mask, figures)
         rows.append((name, figures))
     print_table(rows)
     print(f"\npictures: {args.out}/<scene>.png")
-    sys.exit(0 if all(scenes.passes(f) for _, f in rows) else 1)
+    sys.exit(0 if all(f is not None and scenes.passes(f) for _, f in rows) else 1)
 
 
 if __name__ == "__main__":

@@ -19,8 +19,8 @@ import scenes
 EXAMPLE_SOURCE = scenes.REPO / "crates" / "polar-render" / "examples" / "render_scene.rs"
 
 
-class NotAvailable(Exception):
-    """Our renderer (or the scene file) does not exist yet."""
+class RenderFailed(RuntimeError):
+    """Our renderer exited with an error on a scene (e.g. a scene key it does not know)."""
 
 
 def scene_file(name):
@@ -63,7 +63,7 @@ def render(exe, name, out_dir, spp=None, threads=None):
     proc = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
-        raise RuntimeError(f"`{' '.join(cmd)}` failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
+        raise RenderFailed(f"`{' '.join(cmd)}` failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
     meta = out_dir / "meta.json"
     seconds, source = wall, "wall"
     if meta.is_file():

@@ -64,7 +64,7 @@ def ensure_reference(mi, root, name, spp, seed=0, force=False, log=print):
         "scene": name,
         "renderer": "mitsuba",
         "mitsuba": scenes_version(),
-        "size": [scenes.WIDTH, scenes.HEIGHT],
+        "size": list(scenes.image_size(name)),
         "spp": spp,
         "seed": seed,
         "seconds": round(seconds, 3),

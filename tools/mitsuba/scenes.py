@@ -8,7 +8,9 @@ before the first kernel runs and the polarized Rayleigh phase function
 (rayleigh_phase.py) is registered.
 """
 
+import functools
 import os
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +23,7 @@ LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 REPO = Path(__file__).resolve().parents[2]
 SCENE_DIR = REPO / "datasets-synth" / "scenes" / "crosscheck"
 
-# Camera and lights common to the four scenes (scenes.md, "Common to all four").
+# Camera and lights common to the four surface scenes (scenes.md, "Common to all four").
 WIDTH = HEIGHT = 128
 FOV_DEG = 30.0
 ORIGIN = np.array([0.0, 0.0, 5.0])
@@ -52,17 +54,22 @@ MATERIALS = {
     },
     "dielectric": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0},
 }
-SCENES = list(MATERIALS)
+SURFACE_SCENES = list(MATERIALS)
+
+# The hazy scene (scenes.md, "haze"): a box of Rayleigh medium lit by the sun
+# from the side, a Lambertian sphere inside it, no environment (black behind).
+# Its one source is our scene file, read by haze() below.
+SCENES = SURFACE_SCENES + ["haze"]
 
 # Reference spp per scene: enough for the reference's own S0 error (one render
 # against the truth) to stay near or below 1% over the sphere pixels, as
 # measured between two independent Mitsuba renders (README.md). Mitsuba picks
 # one of the two emitters per next-event estimate, so the sun's highlight on
 # the rough sphere is what needs most samples.
-REFERENCE_SPP = {"conductor": 1024, "roughconductor": 32768, "pplastic": 16384, "dielectric": 4096}
+REFERENCE_SPP = {"conductor": 1024, "roughconductor": 32768, "pplastic": 16384, "dielectric": 4096, "haze": 16384}
 # Our renderer's spp in the cross-check: its own S0 noise about 1% where the
 # reference leaves room (measured: no bias above 0.1%, README.md).
-OURS_SPP = {"conductor": 256, "roughconductor": 16384, "pplastic": 4096, "dielectric": 1024}
+OURS_SPP = {"conductor": 256, "roughconductor": 16384, "pplastic": 4096, "dielectric": 1024, "haze": 4096}
 
 
 def setup_mitsuba(threads=None):
@@ -78,6 +85,52 @@ def setup_mitsuba(threads=None):
         dr.set_thread_count(threads)
     rayleigh_phase.register(mi, dr)
     return mi, dr
+
+
+@functools.cache
+def haze():
+    """The `haze` scene's parameters, read from SCENE_DIR/haze.toml (our
+    renderer's scene file, the one source of the scene): camera size, medium
+    box, sigma_s, sigma_a, the sphere and its albedo, the sun. Everything else
+    in the file must be what the Mitsuba translation assumes (the common camera,
+    max_depth, a Rayleigh phase function, one Lambertian sphere, one sun),
+    else ValueError names the key."""
+    path = SCENE_DIR / "haze.toml"
+    doc = tomllib.loads(path.read_text())
+
+    def need(ok, what):
+        if not ok:
+            raise ValueError(f"{path}: {what} (the Mitsuba translation in scenes.py assumes it)")
+
+    cam, med = doc["camera"], doc["medium"]
+    need(cam["position"] == ORIGIN.tolist() and cam["look_at"] == TARGET.tolist() and cam["up"] == UP.tolist()
+         and cam["fov_deg"] == FOV_DEG, "camera must be the common cross-check camera")
+    need(doc["render"]["max_depth"] == MAX_DEPTH - 1, f"render.max_depth must be {MAX_DEPTH - 1}")
+    need(med["phase"] == {"type": "rayleigh"}, "medium.phase must be rayleigh")
+    (shape,), (light,) = doc["shapes"], doc["lights"]
+    material = doc["materials"][shape["material"]]
+    need(shape["type"] == "sphere" and set(material) == {"type", "albedo"} and material["type"] == "lambertian",
+         "the one shape must be a sphere with a lambertian material")
+    need(light["type"] == "sun" and "polarization" not in light, "the one light must be an unpolarized sun")
+    lo, hi, c = (np.array(v, float) for v in (med["bounds_min"], med["bounds_max"], shape["center"]))
+    need(np.all(lo + shape["radius"] <= c) and np.all(c + shape["radius"] <= hi), "the sphere must lie inside the medium box")
+    return {
+        "size": (cam["width"], cam["height"]),
+        "bounds_min": med["bounds_min"],
+        "bounds_max": med["bounds_max"],
+        "sigma_s": med["sigma_s"],
+        "sigma_a": med["sigma_a"],
+        "center": shape["center"],
+        "radius": shape["radius"],
+        "albedo": material["albedo"],
+        "sun_toward": light["direction"],  # toward the sun: the light travels along -sun_toward
+        "sun_irradiance": light["irradiance"],
+    }
+
+
+def image_size(name):
+    """(width, height) of cross-check scene `name`."""
+    return haze()["size"] if name == "haze" else (WIDTH, HEIGHT)
 
 
 def look_at(mi):
@@ -104,13 +157,51 @@ def sensor_dict(mi, spp, width=WIDTH, height=HEIGHT):
     }
 
 
-def stokes_integrator(max_depth=MAX_DEPTH):
-    """Mitsuba's `stokes` integrator around a path tracer."""
-    return {"type": "stokes", "integrator": {"type": "path", "max_depth": max_depth}}
+def stokes_integrator(max_depth=MAX_DEPTH, inner="path"):
+    """Mitsuba's `stokes` integrator around a path tracer (`volpath` with media)."""
+    return {"type": "stokes", "integrator": {"type": inner, "max_depth": max_depth}}
+
+
+def haze_dict(mi, spp):
+    """The Mitsuba scene of `haze`: the medium fills a null-BSDF cube (its
+    `interior`), and the sphere inside has it as `exterior` so that light
+    leaving the sphere continues in the medium."""
+    h = haze()
+    lo, hi = np.array(h["bounds_min"]), np.array(h["bounds_max"])
+    sigma_t = h["sigma_s"] + h["sigma_a"]
+    medium = {
+        "type": "homogeneous",
+        "sigma_t": sigma_t,
+        "albedo": h["sigma_s"] / sigma_t,
+        "phase": {"type": rayleigh_phase.PLUGIN},
+    }
+    return {
+        "type": "scene",
+        "integrator": stokes_integrator(inner="volpath"),
+        "sensor": sensor_dict(mi, spp, *h["size"]),
+        "haze": medium,
+        "box": {
+            "type": "cube",
+            "to_world": mi.ScalarTransform4f().translate(((lo + hi) / 2).tolist()).scale(((hi - lo) / 2).tolist()),
+            "bsdf": {"type": "null"},
+            "interior": {"type": "ref", "id": "haze"},
+        },
+        "sphere": {
+            "type": "sphere",
+            "center": h["center"],
+            "radius": h["radius"],
+            "bsdf": {"type": "diffuse", "reflectance": h["albedo"]},
+            "exterior": {"type": "ref", "id": "haze"},
+        },
+        "sun": {"type": "directional", "direction": (-np.array(h["sun_toward"], float)).tolist(),
+                "irradiance": h["sun_irradiance"]},
+    }
 
 
 def scene_dict(mi, name, spp):
     """The Mitsuba scene dictionary of cross-check scene `name`."""
+    if name == "haze":
+        return haze_dict(mi, spp)
     return {
         "type": "scene",
         "integrator": stokes_integrator(),
@@ -195,6 +286,23 @@ def sphere_mask():
     b = d @ oc
     disc = b**2 - (oc @ oc - SPHERE_RADIUS**2)
     return (disc > 0) & (-b - np.sqrt(np.maximum(disc, 0)) > 0)
+
+
+def box_mask(lo, hi, width, height):
+    """Pixels whose centre ray crosses the box [lo, hi] (slab test)."""
+    d = pixel_rays(width, height)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1, t2 = (np.array(lo) - ORIGIN) / d, (np.array(hi) - ORIGIN) / d
+    near = np.nanmax(np.minimum(t1, t2), axis=-1)
+    far = np.nanmin(np.maximum(t1, t2), axis=-1)
+    return (far > np.maximum(near, 0.0))
+
+
+def object_mask(name):
+    """The pixels the figures are taken over: the sphere's, or for `haze` the medium box's."""
+    if name == "haze":
+        return box_mask(haze()["bounds_min"], haze()["bounds_max"], *image_size(name))
+    return sphere_mask()
 
 
 def dolp(s):
