@@ -164,8 +164,9 @@ def stokes_integrator(max_depth=MAX_DEPTH, inner="path"):
 
 def haze_dict(mi, spp):
     """The Mitsuba scene of `haze`: the medium fills a null-BSDF cube (its
-    `interior`), and the sphere inside has it as `exterior` so that light
-    leaving the sphere continues in the medium."""
+    `interior`); the sphere inside declares it as its `exterior` (volpath
+    keeps the current medium at a surface that is no medium transition, so
+    this only makes the nesting explicit: same image, README.md)."""
     h = haze()
     lo, hi = np.array(h["bounds_min"]), np.array(h["bounds_max"])
     sigma_t = h["sigma_s"] + h["sigma_a"]
