@@ -38,5 +38,5 @@ step "Mitsuba 3: polarized Rayleigh phase function in volpath"
 step "BSDF Mueller matrices vs Mitsuba 3"
 "$py" tools/bsdf_crosscheck.py
 
-step "simulator vs Mitsuba 3 (four converged scenes)"
+step "simulator vs Mitsuba 3 (four converged surface scenes and haze)"
 "$py" tools/mitsuba/crosscheck.py out/crosscheck --threads 2
