@@ -27,11 +27,16 @@ pub struct StokesArgs {
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Demosaicing method: superpixel (half resolution, no interpolation), bilinear
-    /// (= polanalyser COLOR_PolarMono, bit-exact; fastest full-resolution method),
-    /// newton (Newton-polynomial, Li et al. 2019: better on fine texture, worse at
-    /// polarization edges; see the demosaic_error example of polar-sensor).
-    #[arg(long, value_name = "NAME", default_value = "bilinear", value_parser = parse_method)]
+    /// Demosaicing method (error table and speed: README "Demosaicing error"):
+    ///   residual    the default: edge-aware residual interpolation (Ahmed et al. 2017,
+    ///               Morimatsu et al. 2020); lowest error on edges and fine texture, ~2-3x bilinear's time
+    ///   bilinear    polanalyser's COLOR_PolarMono, bit-exact; the fastest full-resolution
+    ///               method: to match polanalyser/OpenCV, or when speed matters most
+    ///   newton      Newton polynomial (Li et al. 2019): for comparison; beats bilinear on
+    ///               fine texture, loses at polarization edges; the slowest
+    ///   superpixel  half resolution, no interpolation: quick looks
+    #[arg(verbatim_doc_comment)]
+    #[arg(long, value_name = "NAME", default_value = "residual", value_parser = parse_method)]
     pub demosaic: DemosaicMethod,
     /// Significant bits of the sensor data (8, 10, 12 or 16). Default: the PNG's
     /// sample depth. Use 10 or 12 for such sensors stored in 16-bit PNGs, with --align.

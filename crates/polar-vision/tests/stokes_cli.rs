@@ -270,3 +270,32 @@ fn help_explains_every_option() {
         assert!(help.contains(needle), "help lacks {needle}:\n{help}");
     }
 }
+
+/// `--help` gives every method a line, and without `--demosaic` the output is
+/// `residual`'s (the method with the lowest error in the README's table).
+#[test]
+fn help_lists_every_method_and_the_default_is_residual() {
+    let help = String::from_utf8(run(&["stokes", "--help"]).stdout).unwrap();
+    for m in DemosaicMethod::ALL {
+        assert!(
+            help.lines().any(|l| l.trim_start().starts_with(m.name())),
+            "no line for {m} in:\n{help}"
+        );
+    }
+    assert!(help.contains("[default: residual]"), "{help}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let raw = mosaic8(12, 10);
+    let input = dir.path().join("raw.png");
+    polar_io::write_gray8_png(&input, &raw).unwrap();
+    let out_dir = dir.path().join("out");
+    assert!(
+        run(&["stokes", p(&input), "--out", p(&out_dir)])
+            .status
+            .success()
+    );
+    let got =
+        polar_io::read_exr(out_dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS).unwrap();
+    let want = stokes_planes(&raw, DemosaicMethod::Residual).unwrap();
+    assert_eq!(got, want.linear_stokes());
+}

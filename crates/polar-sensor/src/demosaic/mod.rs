@@ -8,10 +8,13 @@
 //! - `newton`: Newton-polynomial interpolation with the polarization-difference
 //!   model and edge classifier of Li, Zhao, Pan and Kong, "Demosaicking DoFP images
 //!   using Newton's polynomial interpolation and polarization difference model",
-//!   Opt. Express 27, 1376 (2019) (see [`newton`]).
+//!   Opt. Express 27, 1376 (2019) (see [`newton`]);
+//! - `residual`: edge-aware residual interpolation around an `S0/2` guide from the
+//!   orthogonal polarizer pairs (Ahmed et al. 2017; Morimatsu et al. 2020), see [`residual`].
 
 pub mod bilinear;
 pub mod newton;
+pub mod residual;
 
 use std::fmt;
 use std::str::FromStr;
@@ -31,11 +34,18 @@ pub enum DemosaicMethod {
     Bilinear,
     /// Newton-polynomial interpolation with polarization-difference model (Li et al. 2019).
     Newton,
+    /// Edge-aware residual interpolation around an `S0/2` guide (Ahmed et al. 2017, Morimatsu et al. 2020).
+    Residual,
 }
 
 impl DemosaicMethod {
     /// Every method, in the order used by tables and help texts.
-    pub const ALL: [DemosaicMethod; 3] = [Self::Superpixel, Self::Bilinear, Self::Newton];
+    pub const ALL: [DemosaicMethod; 4] = [
+        Self::Superpixel,
+        Self::Bilinear,
+        Self::Newton,
+        Self::Residual,
+    ];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -43,6 +53,7 @@ impl DemosaicMethod {
             Self::Superpixel => "superpixel",
             Self::Bilinear => "bilinear",
             Self::Newton => "newton",
+            Self::Residual => "residual",
         }
     }
 
@@ -66,6 +77,7 @@ impl DemosaicMethod {
             Self::Superpixel => 0,
             Self::Bilinear => 1,
             Self::Newton => 10,
+            Self::Residual => 3,
         }
     }
 }
@@ -99,6 +111,7 @@ pub fn demosaic<T: MosaicSample>(
         DemosaicMethod::Superpixel => superpixel(raw),
         DemosaicMethod::Bilinear => bilinear::bilinear(raw),
         DemosaicMethod::Newton => newton::newton(raw),
+        DemosaicMethod::Residual => residual::residual(raw),
     })
 }
 
@@ -146,21 +159,31 @@ mod tests {
 
     #[test]
     fn odd_and_tiny_mosaics_are_rejected() {
-        let odd = Mosaic::<u8>::new(5, 4);
-        assert_eq!(
-            demosaic(&odd, DemosaicMethod::Bilinear).unwrap_err(),
-            SensorError::OddSize {
-                width: 5,
-                height: 4
-            }
-        );
-        let tiny = Mosaic::<u8>::new(2, 1);
-        assert_eq!(
-            demosaic(&tiny, DemosaicMethod::Newton).unwrap_err(),
-            SensorError::TooSmall {
-                width: 2,
-                height: 1
-            }
-        );
+        for m in DemosaicMethod::ALL {
+            assert_eq!(
+                demosaic(&Mosaic::<u8>::new(5, 4), m).unwrap_err(),
+                SensorError::OddSize {
+                    width: 5,
+                    height: 4
+                },
+                "{m}"
+            );
+            assert_eq!(
+                demosaic(&Mosaic::<u8>::new(4, 7), m).unwrap_err(),
+                SensorError::OddSize {
+                    width: 4,
+                    height: 7
+                },
+                "{m}"
+            );
+            assert_eq!(
+                demosaic(&Mosaic::<u8>::new(2, 1), m).unwrap_err(),
+                SensorError::TooSmall {
+                    width: 2,
+                    height: 1
+                },
+                "{m}"
+            );
+        }
     }
 }
