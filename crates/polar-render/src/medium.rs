@@ -188,13 +188,9 @@ impl Medium {
                 return Err((k.into(), format!("must be finite and >= 0, got {v}")));
             }
         }
-        if let Err(e) = self.phase.validate() {
-            let key = match &e {
-                OpticsError::OutOfRange { name, .. } => format!("phase.{name}"),
-                _ => "phase".into(),
-            };
-            return Err((key, e.to_string()));
-        }
+        self.phase
+            .validate()
+            .map_err(|e| (phase_key(&e), e.to_string()))?;
         if let Some(d) = &self.density {
             d.validate().map_err(|(k, r)| (format!("density.{k}"), r))?;
         }
@@ -211,5 +207,16 @@ impl Medium {
         self.density
             .as_ref()
             .map_or(1.0, |g| g.at(&self.box_coordinates(p)))
+    }
+}
+
+/// The scene-file key under `medium` that a phase-function error is about.
+pub(crate) fn phase_key(e: &OpticsError) -> String {
+    match e {
+        OpticsError::OutOfRange { name, .. } if name.starts_with("relative_index") => {
+            "phase.ior".into()
+        }
+        OpticsError::OutOfRange { name, .. } => format!("phase.{name}"),
+        _ => "phase".into(),
     }
 }

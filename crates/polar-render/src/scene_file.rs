@@ -3,9 +3,10 @@
 //! errors) and every error names the file, the key and the reason.
 
 use crate::Error;
-use crate::medium::{DensityGrid, Medium};
+use crate::medium::{DensityGrid, Medium, phase_key};
 use crate::scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, Vec3};
 use crate::shapes;
+use num_complex::Complex64;
 use polar_optics::scatter::PhaseFunction;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -54,7 +55,15 @@ enum PhaseDesc {
         #[serde(default = "one")]
         depolarization: f64,
     },
+    Mie {
+        size_parameter: f64,
+        ior: [f64; 2],
+    },
 }
+
+/// Largest Mie size parameter a scene file may ask for: the table's cost grows as
+/// `x²` and its accuracy is measured up to `x = 1000` (`polar_optics::scatter::MieTable`).
+const MAX_SIZE_PARAMETER: f64 = 1000.0;
 
 fn one() -> f64 {
     1.0
@@ -277,14 +286,23 @@ fn medium(m: MediumDesc, file: &Path) -> Result<Medium, Error> {
     let phase = match m.phase {
         PhaseDesc::Rayleigh {} => Ok(PhaseFunction::Rayleigh),
         PhaseDesc::Hg { g, depolarization } => PhaseFunction::henyey_greenstein(g, depolarization),
+        PhaseDesc::Mie {
+            size_parameter,
+            ior: [n, k],
+        } => {
+            if size_parameter > MAX_SIZE_PARAMETER {
+                return Err(invalid(
+                    file,
+                    "medium.phase.size_parameter",
+                    format!(
+                        "{size_parameter} exceeds {MAX_SIZE_PARAMETER} (use `hg` for large particles)"
+                    ),
+                ));
+            }
+            PhaseFunction::mie(size_parameter, Complex64::new(n, k))
+        }
     }
-    .map_err(|e| {
-        let key = match &e {
-            polar_optics::OpticsError::OutOfRange { name, .. } => format!("medium.phase.{name}"),
-            _ => "medium.phase".into(),
-        };
-        invalid(file, key, e.to_string())
-    })?;
+    .map_err(|e| invalid(file, format!("medium.{}", phase_key(&e)), e.to_string()))?;
     let (lo, hi) = (Vec3::from(m.bounds_min), Vec3::from(m.bounds_max));
     let density = m.density.map(|d| density(d, &lo, &hi, file)).transpose()?;
     Ok(Medium {

@@ -399,3 +399,28 @@ fn hazy_render_is_bit_identical_across_thread_counts_and_has_ground_truth() {
         one.clear.as_ref().expect("clear").as_slice()
     );
 }
+
+#[test]
+fn mie_medium_needs_full_transport() {
+    // Mie's S34 couples circular and linear polarization: the cheapest exact model is Full,
+    // and Linear is refused.
+    let mut s = hazy_sphere(None);
+    s.medium.as_mut().expect("medium").phase =
+        PhaseFunction::mie(2.0, num_complex::Complex64::new(1.33, 0.0)).expect("mie");
+    s.settings.spp = 4;
+    assert_eq!(polar_render::required_model(&s), Polarization::Full);
+    let err = render(
+        &s,
+        &RenderOptions {
+            force_model: Some(Polarization::Linear),
+        },
+        &|_, _| {},
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, polar_render::Error::ModelTooCheap { .. }),
+        "{err}"
+    );
+    let out = run(&s, None);
+    assert!(out.stokes.as_slice().iter().all(|v| v.is_finite()));
+}

@@ -233,6 +233,27 @@ fn bad_medium_values_are_named() {
             "unknown field",
         ),
         (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\nphase = {{ type = \"mie\", size_parameter = 1e9, ior = [1.33, 0.0] }}\n"
+            ),
+            "medium.phase.size_parameter",
+            "exceeds 1000",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\nphase = {{ type = \"mie\", size_parameter = 2.0, ior = [1.33, -0.1] }}\n"
+            ),
+            "medium.phase.ior",
+            "-0.1",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\nphase = {{ type = \"mie\", size_parameter = 0.0, ior = [1.33, 0.0] }}\n"
+            ),
+            "medium.phase.size_parameter",
+            "0",
+        ),
+        (
             format!("{MEDIUM}sigma_s = 1.0\nphase = {{ type = \"rayleigh\", g = 0.5 }}\n"),
             "g",
             "unknown field",
