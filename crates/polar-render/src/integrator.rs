@@ -286,7 +286,7 @@ pub(crate) fn radiance<R: Transport>(
             Flight::Pass { weight } => {
                 throughput = throughput.scaled(weight);
                 let Some(hit) = hit else {
-                    if let Some(le) = world.environment() {
+                    if let Some(le) = world.environment(&-d) {
                         let w = match &bounce {
                             Bounce::Specular => 1.0,
                             Bounce::Smooth { pdf, n, .. } => {

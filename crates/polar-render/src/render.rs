@@ -71,6 +71,7 @@ pub fn required_model(scene: &Scene) -> Polarization {
         crate::Light::Environment(e) | crate::Light::Sun { emission: e, .. } => {
             emission_polarization(&e.polarization)
         }
+        crate::Light::Sky(_) => Polarization::Linear,
     });
     let medium = scene.medium.iter().map(|m| m.polarization());
     materials

@@ -9,6 +9,8 @@
 use crate::medium::Medium;
 use crate::{Error, Material};
 use nalgebra::{Matrix4, Vector3};
+use polar_optics::OpticsError;
+use polar_optics::sky::RayleighSky;
 use std::path::Path;
 
 /// A 3-vector in world space.
@@ -92,6 +94,24 @@ pub enum Light {
         /// Irradiance on a surface facing the sun, with its polarization.
         emission: Emission,
     },
+    /// A polarized single-scattering Rayleigh sky (`polar_optics::sky`): an
+    /// environment whose Stokes radiance depends on the direction (zero below
+    /// the horizon), together with its sun, a directional light of irradiance
+    /// `sun_irradiance · e^{−τ/μ0}`. It counts as the environment (at most one).
+    Sky(RayleighSky),
+}
+
+/// The scene-file key (under the light) that a sky error is about: the field named
+/// in the error (`"|up|"` → `up`, `"sun_direction . up"` → `sun_direction`).
+pub(crate) fn sky_key(e: &OpticsError) -> &'static str {
+    match e {
+        OpticsError::OutOfRange { name, .. } => name
+            .trim_start_matches('|')
+            .split(['|', ' '])
+            .next()
+            .unwrap_or(name),
+        _ => "sky",
+    }
 }
 
 /// An indexed triangle mesh in world space.
@@ -270,6 +290,12 @@ impl Scene {
         let mut environments = 0;
         for (i, l) in self.lights.iter().enumerate() {
             let (e, key) = match l {
+                Light::Sky(sky) => {
+                    environments += 1;
+                    sky.validate()
+                        .or_else(|e| bad(format!("lights[{i}].{}", sky_key(&e)), e.to_string()))?;
+                    continue;
+                }
                 Light::Environment(e) => {
                     environments += 1;
                     (e, "radiance")
@@ -303,7 +329,7 @@ impl Scene {
         if environments > 1 {
             return bad(
                 "lights".into(),
-                format!("{environments} environment lights; at most one is allowed"),
+                format!("{environments} environment or sky lights; at most one is allowed"),
             );
         }
         if let Some(m) = &self.medium {

@@ -4,10 +4,13 @@
 
 use crate::Error;
 use crate::medium::{DensityGrid, Medium, phase_key};
-use crate::scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, Vec3};
+use crate::scene::{
+    Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, Vec3, sky_key,
+};
 use crate::shapes;
 use num_complex::Complex64;
 use polar_optics::scatter::PhaseFunction;
+use polar_optics::sky::RayleighSky;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -174,6 +177,17 @@ enum LightDesc {
         irradiance: f64,
         polarization: Option<[f64; 3]>,
     },
+    Sky {
+        sun_direction: [f64; 3],
+        #[serde(default = "y_up")]
+        up: [f64; 3],
+        optical_depth: f64,
+        sun_irradiance: f64,
+    },
+}
+
+fn y_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
 }
 
 /// Reads and validates a scene file; mesh paths are relative to the file's directory.
@@ -255,8 +269,24 @@ fn build(desc: SceneFile, file: &Path, base: &Path) -> Result<Scene, Error> {
             .shapes
             .push(shape(s, &format!("shapes[{i}]"), &names, file, base)?);
     }
-    for l in desc.lights {
+    for (i, l) in desc.lights.into_iter().enumerate() {
         scene.lights.push(match l {
+            LightDesc::Sky {
+                sun_direction,
+                up,
+                optical_depth,
+                sun_irradiance,
+            } => Light::Sky(
+                RayleighSky::new(
+                    sun_direction.into(),
+                    up.into(),
+                    optical_depth,
+                    sun_irradiance,
+                )
+                .map_err(|e| {
+                    invalid(file, format!("lights[{i}].{}", sky_key(&e)), e.to_string())
+                })?,
+            ),
             LightDesc::Environment {
                 radiance,
                 polarization,

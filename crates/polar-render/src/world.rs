@@ -7,14 +7,15 @@ use crate::sampler::Sampler;
 use crate::scene::{Emission, Light, Scene, Vec3};
 use crate::tracking::{self, Flight};
 use polar_optics::Stokes;
+use polar_optics::sky::RayleighSky;
 use std::f64::consts::PI;
 
 /// A light with extent, as the integrator picks it (uniformly among them; suns,
 /// being delta lights, are not picked but all sampled at every vertex).
 #[derive(Clone, Debug)]
 enum LightRef {
-    /// The constant environment.
-    Environment(Emission),
+    /// The environment (constant or sky), see [`Environment`].
+    Environment,
     /// An emissive shape: its primitives (indices into `Accel::prims`) with an
     /// area CDF, and the total area.
     Area {
@@ -23,6 +24,24 @@ enum LightRef {
         cdf: Vec<f64>,
         area: f64,
     },
+}
+
+/// Radiance arriving from infinitely far away.
+enum Environment<'a> {
+    /// The same Stokes radiance from every direction.
+    Constant(Stokes),
+    /// A polarized sky.
+    Sky(&'a RayleighSky),
+}
+
+impl Environment<'_> {
+    /// Stokes radiance propagating along `k`, in the frame `stokes_basis(k)`.
+    fn radiance(&self, k: &Vec3) -> Stokes {
+        match self {
+            Environment::Constant(s) => *s,
+            Environment::Sky(sky) => sky.radiance(k),
+        }
+    }
 }
 
 /// A sampled light direction.
@@ -47,7 +66,7 @@ pub(crate) struct World<'a> {
     lights: Vec<LightRef>,
     /// Directional lights: unit direction toward the sun and its emission.
     suns: Vec<(Vec3, Emission)>,
-    environment: Option<Emission>,
+    environment: Option<Environment<'a>>,
     /// Index in `lights` of each emissive shape (for MIS when a BSDF ray hits it).
     area_index: Vec<Option<usize>>,
 }
@@ -75,14 +94,23 @@ impl<'a> World<'a> {
         let accel = Accel::build(scene);
         let mut lights = Vec::new();
         let mut suns = Vec::new();
+        let mut environment = None;
         for l in &scene.lights {
             match l {
-                Light::Environment(e) => lights.push(LightRef::Environment(*e)),
+                Light::Environment(e) => environment = Some(Environment::Constant(e.stokes())),
+                Light::Sky(sky) => {
+                    environment = Some(Environment::Sky(sky));
+                    let sun = sky.sun_irradiance * sky.sun_transmittance();
+                    suns.push((sky.sun_direction, Emission::unpolarized(sun)));
+                }
                 Light::Sun {
                     direction,
                     emission,
                 } => suns.push((direction.normalize(), *emission)),
             }
+        }
+        if environment.is_some() {
+            lights.push(LightRef::Environment);
         }
         let mut area_index = vec![None; scene.shapes.len()];
         for (s, shape) in scene.shapes.iter().enumerate() {
@@ -110,10 +138,6 @@ impl<'a> World<'a> {
                 });
             }
         }
-        let environment = scene.lights.iter().find_map(|l| match l {
-            Light::Environment(e) => Some(*e),
-            Light::Sun { .. } => None,
-        });
         Self {
             camera: PinholeCamera::new(&scene.camera),
             scene,
@@ -148,9 +172,10 @@ impl<'a> World<'a> {
             .map_or(1.0, |m| tracking::transmittance(m, o, d, t_max, sampler))
     }
 
-    /// Environment radiance (Stokes in the implicit frame), if there is an environment.
-    pub fn environment(&self) -> Option<Stokes> {
-        self.environment.map(|e| e.stokes())
+    /// Environment radiance propagating along `k` (Stokes in the implicit frame of
+    /// `k`), if there is an environment.
+    pub fn environment(&self, k: &Vec3) -> Option<Stokes> {
+        self.environment.as_ref().map(|e| e.radiance(k))
     }
 
     /// Emitted Stokes leaving the front side of `hit` toward `-d`.
@@ -211,16 +236,17 @@ impl<'a> World<'a> {
         let pick = self.pick_probability();
         let index = ((u[0] * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
         match &self.lights[index] {
-            LightRef::Environment(e) => {
+            LightRef::Environment => {
                 let wi = match n {
                     Some(n) => cosine_direction(n, [u[1], u[2]]),
                     None => sphere_direction([u[1], u[2]]),
                 };
                 let pdf = self.environment_pdf(n, &wi);
-                (pdf > 0.0).then(|| LightSample {
+                let stokes = self.environment(&-wi)?;
+                (pdf > 0.0).then_some(LightSample {
                     wi,
                     dist: f64::INFINITY,
-                    stokes: e.stokes(),
+                    stokes,
                     pdf,
                     is_delta: false,
                 })

@@ -263,3 +263,27 @@ fn bad_medium_values_are_named() {
         assert_names(parse(&body).unwrap_err(), key, reason);
     }
 }
+
+#[test]
+fn sky_light_is_read_and_checked() {
+    let sky = "[[lights]]\ntype = \"sky\"\nsun_direction = [1.0, 1.0, 0.0]\noptical_depth = 0.1\nsun_irradiance = 2.0\n";
+    let scene = parse(sky).expect("sky");
+    let polar_render::Light::Sky(s) = &scene.lights[0] else {
+        panic!("not a sky")
+    };
+    assert!((s.sun_direction.norm() - 1.0).abs() < 1e-12 && s.up == nalgebra::Vector3::y());
+    let below = sky.replace("[1.0, 1.0, 0.0]", "[1.0, -1.0, 0.0]");
+    assert_names(
+        parse(&below).unwrap_err(),
+        "lights[0].sun_direction",
+        "horizon",
+    );
+    let negative = sky.replace("optical_depth = 0.1", "optical_depth = -1.0");
+    assert_names(
+        parse(&negative).unwrap_err(),
+        "lights[0].optical_depth",
+        "-1",
+    );
+    let zero = sky.replace("[1.0, 1.0, 0.0]", "[0.0, 0.0, 0.0]");
+    assert_names(parse(&zero).unwrap_err(), "lights[0].sun_direction", "unit");
+}
