@@ -5,10 +5,13 @@
 //! Transmission carries radiance: the flux-unit Fresnel matrix is scaled by
 //! `1/η²` with `η = n(wi side) / n(wo side)` (the `eta` of the sample).
 
-use crate::geometry::{V3, reflect, reflect_z, reflectance, reflection, refract, transmission};
+use crate::geometry::{
+    V3, from_sp_frame, reflect, reflect_z, reflectance, reflection, refract, transmission,
+};
 use crate::microfacet::Ggx;
 use crate::{BsdfSample, Model, Polarization};
 use polar_optics::Mueller;
+use polar_optics::fresnel::fresnel_amplitudes;
 
 /// A dielectric interface: smooth when `roughness` is `None`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,15 +28,20 @@ impl Dielectric {
         if w.z > 0.0 { self.eta } else { 1.0 / self.eta }
     }
 
+    /// One Fresnel evaluation serves both lobes: the flux-unit transmission
+    /// matrix in the s/p frame is the same from either side (Stokes relations;
+    /// tested in polar-optics), so that of light leaving along `wo` is used.
     fn smooth_sample(&self, wo: &V3, u: f64) -> Option<BsdfSample> {
         let etap = self.etap(wo);
         let wr = reflect_z(wo);
-        let r_mueller = reflection(etap.into(), &V3::z(), wo, &wr);
+        let fresnel = fresnel_amplitudes(wo.z.abs(), etap.into());
+        let r_mueller = from_sp_frame(&fresnel.reflection_mueller(), &V3::z(), wo, &wr);
         let r = r_mueller[(0, 0)];
         let n = V3::z() * wo.z.signum();
         match refract(wo, &n, etap) {
             Some(wt) if u >= r => {
-                let t = transmission(1.0 / etap, &V3::z(), wo, &wt) / (etap * etap);
+                let t = from_sp_frame(&fresnel.transmission_mueller(), &V3::z(), wo, &wt)
+                    / (etap * etap);
                 let pt = 1.0 - r;
                 Some(BsdfSample {
                     wi: wt,

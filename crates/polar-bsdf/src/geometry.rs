@@ -55,14 +55,15 @@ pub(crate) fn cosine_hemisphere_pdf(w: &V3) -> f64 {
     w.z.max(0.0) * FRAC_1_PI
 }
 
-/// The s axis of the plane of incidence spanned by `normal` and `k`:
-/// `normalize(normal × k)`; any axis perpendicular to `k` when they are collinear
-/// (normal incidence, where the Fresnel matrix is isotropic).
+/// The s axis of the plane of incidence spanned by `normal` and `k`: `normal × k`,
+/// *not normalized* (it only feeds basis rotations, whose `double_angle` is
+/// invariant to the length of its axes: a square root and a division saved);
+/// any axis perpendicular to `k` when they are collinear (normal incidence,
+/// where the Fresnel matrix is isotropic).
 pub(crate) fn s_axis(normal: &V3, k: &V3) -> V3 {
     let c = normal.cross(k);
-    let n2 = c.norm_squared();
-    if n2 > DEGENERATE_SQ {
-        c / n2.sqrt()
+    if c.norm_squared() > DEGENERATE_SQ {
+        c
     } else {
         stokes_basis(k)
     }
@@ -87,20 +88,25 @@ pub(crate) fn to_bsdf_bases(m: &Mueller, k_in: &V3, s_in: &V3, k_out: &V3, s_out
 /// leaving along `wo`, for relative index `eta = n_transmitted / n_incident`
 /// (complex for conductors), in the BSDF bases.
 pub(crate) fn reflection(eta: num_complex::Complex64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
-    let k_in = -wi;
     let f = fresnel_amplitudes(wi.dot(m).abs(), eta).reflection_mueller();
+    from_sp_frame(&f, m, wo, wi)
+}
+
+/// Re-expresses a Mueller matrix `f` given in the s/p frame of the plane of
+/// incidence at the (micro)normal `m` (light arriving along `-wi`, leaving along
+/// `wo`; x = s on both sides) in the BSDF bases.
+pub(crate) fn from_sp_frame(f: &Mueller, m: &V3, wo: &V3, wi: &V3) -> Mueller {
+    let k_in = -wi;
     let s = s_axis(m, &k_in);
-    to_bsdf_bases(&f, &k_in, &s, wo, &s)
+    to_bsdf_bases(f, &k_in, &s, wo, &s)
 }
 
 /// Fresnel transmission (energy-flux units, no radiance scaling) at the
 /// (micro)normal `m` of light arriving along `-wi` and leaving along `wo`, for the
 /// real relative index `eta = n_wo_side / n_wi_side`, in the BSDF bases.
 pub(crate) fn transmission(eta: f64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
-    let k_in = -wi;
     let f = fresnel_amplitudes(wi.dot(m).abs(), eta.into()).transmission_mueller();
-    let s = s_axis(m, &k_in);
-    to_bsdf_bases(&f, &k_in, &s, wo, &s)
+    from_sp_frame(&f, m, wo, wi)
 }
 
 /// Unpolarized reflectance `(R_s + R_p) / 2` of light arriving at `cos_i` for relative index `eta`.

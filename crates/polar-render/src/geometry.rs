@@ -158,10 +158,16 @@ pub(crate) struct PrimHit {
 
 /// The scene's primitives and their BVH.
 pub(crate) struct Accel {
+    /// `None` for at most [`BRUTE_FORCE_MAX`] primitives, which rays test one by one.
     bvh: Option<CwBvh>,
     /// Primitives in obvhs's order (index = obvhs primitive id).
     pub prims: Vec<Primitive>,
 }
+
+/// Up to this many primitives a ray tests each directly: a BVH traversal (f32
+/// ray set-up, node tests) costs more than a few analytic tests. Measured on
+/// the one-sphere cross-check scenes: see tools/mitsuba/README.md.
+const BRUTE_FORCE_MAX: usize = 4;
 
 /// Self-intersection guard for rays leaving a surface, relative to the scene scale.
 pub(crate) const RAY_EPSILON: f64 = 1e-7;
@@ -192,7 +198,7 @@ impl Accel {
                 }
             }
         }
-        if prims.is_empty() {
+        if prims.len() <= BRUTE_FORCE_MAX {
             return Self { bvh: None, prims };
         }
         let bvh = build_cwbvh(
@@ -218,7 +224,9 @@ impl Accel {
 
     /// Closest primitive hit along the unit direction `d` in `(tmin, tmax)`: `(primitive, t, b1, b2)`.
     pub fn closest(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
-        let bvh = self.bvh.as_ref()?;
+        let Some(bvh) = &self.bvh else {
+            return self.closest_brute_force(o, d, tmin, tmax);
+        };
         let mut hit = RayHit::none();
         // The closest candidate in f64, kept as found (no second intersection test).
         let mut best: Option<PrimHit> = None;
@@ -241,9 +249,26 @@ impl Accel {
         best
     }
 
+    /// [`Self::closest`] by testing every primitive (small scenes).
+    fn closest_brute_force(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
+        let mut best: Option<PrimHit> = None;
+        for (prim, p) in self.prims.iter().enumerate() {
+            let limit = best.as_ref().map_or(tmax, |b| b.t);
+            if let Some((t, b1, b2)) = p.intersect(o, d, tmin, limit) {
+                best = Some(PrimHit { prim, t, b1, b2 });
+            }
+        }
+        best
+    }
+
     /// `true` when nothing blocks the segment from `o` along `d` over `(tmin, tmax)`.
     pub fn unoccluded(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> bool {
-        let Some(bvh) = &self.bvh else { return true };
+        let Some(bvh) = &self.bvh else {
+            return self
+                .prims
+                .iter()
+                .all(|p| p.intersect(o, d, tmin, tmax).is_none());
+        };
         bvh.ray_traverse_miss(Self::f32_ray(o, d, tmax), |_, id| {
             self.prims[id]
                 .intersect(o, d, tmin, tmax)
@@ -308,5 +333,69 @@ impl Accel {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Camera, Shape};
+
+    fn scene(shapes: Vec<Geometry>) -> Scene {
+        let mut scene = Scene::new(Camera {
+            position: Vec3::new(0.0, 0.0, 5.0),
+            look_at: Vec3::zeros(),
+            up: Vec3::y(),
+            fov_deg: 40.0,
+            width: 8,
+            height: 8,
+        });
+        scene.shapes = shapes.into_iter().map(|g| Shape::new(g, 0)).collect();
+        scene
+    }
+
+    #[test]
+    fn brute_force_finds_what_the_bvh_finds() {
+        // Two overlapping spheres in front of a rectangle (4 primitives: tested one
+        // by one); a fifth primitive, far behind the ray origins, switches on the BVH.
+        let sphere = |x: f64, r: f64| Geometry::Sphere {
+            center: Vec3::new(x, 0.0, 0.0),
+            radius: r,
+        };
+        let wall = Geometry::Mesh(crate::shapes::rectangle().transformed(
+            &crate::shapes::transform([0.0, 0.0, -2.0], [0.0; 3], [3.0; 3]),
+        ));
+        let small = scene(vec![sphere(-0.4, 1.0), sphere(0.6, 0.8), wall]);
+        let mut big = small.clone();
+        big.shapes.push(Shape::new(
+            Geometry::Sphere {
+                center: Vec3::new(0.0, 0.0, 100.0),
+                radius: 1.0,
+            },
+            0,
+        ));
+        let (a, b) = (Accel::build(&small), Accel::build(&big));
+        assert!(a.bvh.is_none() && b.bvh.is_some());
+        let o = Vec3::new(0.1, 0.05, 5.0);
+        let mut shapes_hit = [0; 3];
+        for i in 0..400 {
+            let (u, v) = ((i % 20) as f64 / 19.0 - 0.5, (i / 20) as f64 / 19.0 - 0.5);
+            let d = Vec3::new(u, v, -1.0).normalize();
+            let (ha, hb) = (
+                a.closest(&o, &d, 0.0, f64::INFINITY),
+                b.closest(&o, &d, 0.0, f64::INFINITY),
+            );
+            assert_eq!(ha.is_some(), hb.is_some(), "ray {i}");
+            if let (Some(ha), Some(hb)) = (ha, hb) {
+                let shape = a.prims[ha.prim].shape();
+                assert_eq!(shape, b.prims[hb.prim].shape(), "ray {i}");
+                // Same primitive test in f64 on both sides: the same distance.
+                assert_eq!(ha.t, hb.t, "ray {i}");
+                shapes_hit[shape] += 1;
+                assert!(!a.unoccluded(&o, &d, 0.0, ha.t * 1.001), "ray {i}");
+                assert!(a.unoccluded(&o, &d, 0.0, ha.t * 0.999), "ray {i}");
+            }
+        }
+        assert!(shapes_hit.iter().all(|&n| n > 0), "{shapes_hit:?}");
     }
 }

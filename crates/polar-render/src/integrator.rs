@@ -208,8 +208,8 @@ impl Vertex<'_> {
 }
 
 /// Next-event estimation at `vertex`: every sun, and one light with extent (MIS
-/// against the vertex's own sampling), each attenuated by the medium. The random
-/// numbers are drawn even at delta vertices, so the streams do not depend on it.
+/// against the vertex's own sampling), each attenuated by the medium. Delta
+/// vertices skip the light's random numbers, so the streams do not depend on it.
 /// `to_path` takes a matrix of this vertex into the path frame.
 fn next_event<R: Transport>(
     world: &World,
@@ -219,10 +219,11 @@ fn next_event<R: Transport>(
     sampler: &mut Sampler,
     sum: &mut Stokes,
 ) {
-    let u_light = sampler.next_3d();
     if vertex.is_delta() {
+        sampler.skip(3);
         return;
     }
+    let u_light = sampler.next_3d();
     let p = vertex.p();
     let lights = world
         .sun_samples()

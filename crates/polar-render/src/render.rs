@@ -3,7 +3,7 @@
 
 use crate::Error;
 use crate::integrator::radiance;
-use crate::sampler::Sampler;
+use crate::sampler::PixelStreams;
 use crate::scene::Scene;
 use crate::transport::{Full, Linear, Scalar, Transport, emission_polarization};
 use crate::world::World;
@@ -184,10 +184,10 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
     };
     for y in y0..y0 + th {
         for x in x0..x0 + tw {
-            let pixel = (y * cam.width + x) as u64;
+            let streams = PixelStreams::new(settings.seed, (y * cam.width + x) as u64);
             let mut sum = Stokes::zeros();
             for s in 0..settings.spp {
-                let mut sampler = Sampler::new(settings.seed, pixel, u64::from(s));
+                let mut sampler = streams.sample(u64::from(s));
                 let [jx, jy] = sampler.next_2d();
                 let d = world.camera.direction(x as f64 + jx, y as f64 + jy);
                 sum += radiance::<R>(world, &d, &world.camera.film_frame(&d), &mut sampler);

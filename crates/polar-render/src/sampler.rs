@@ -9,6 +9,9 @@ pub struct Sampler {
     dimension: u64,
 }
 
+/// SplitMix64's increment (the golden ratio in 64 bits).
+const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
+
 /// SplitMix64 finaliser (Steele et al. 2014): a bijective 64-bit mixer.
 fn mix(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
@@ -16,17 +19,34 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The streams of every sample of one pixel: hashes the seed and pixel once.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelStreams(u64);
+
+impl PixelStreams {
+    /// The streams of pixel `pixel` under `seed`.
+    pub fn new(seed: u64, pixel: u64) -> Self {
+        Self(mix(mix(seed) ^ pixel))
+    }
+
+    /// The stream of sample `sample` (the same as [`Sampler::new`]).
+    pub fn sample(&self, sample: u64) -> Sampler {
+        let key = mix(self.0 ^ sample.wrapping_mul(GAMMA));
+        Sampler { key, dimension: 0 }
+    }
+}
+
 impl Sampler {
     /// The stream of sample `sample` of pixel `pixel` under `seed`.
     pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
-        let key = mix(mix(mix(seed) ^ pixel) ^ sample.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        Self { key, dimension: 0 }
+        PixelStreams::new(seed, pixel).sample(sample)
     }
 
-    /// The next uniform number in `[0, 1)` (53 random bits).
+    /// The next uniform number in `[0, 1)` (53 random bits): SplitMix64's output
+    /// for state `key + dimension · γ` (one mix per number).
     pub fn next_1d(&mut self) -> f64 {
         self.dimension += 1;
-        let bits = mix(self.key ^ mix(self.dimension));
+        let bits = mix(self.key.wrapping_add(self.dimension.wrapping_mul(GAMMA)));
         (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
@@ -38,6 +58,12 @@ impl Sampler {
     /// Three numbers in `[0, 1)`.
     pub fn next_3d(&mut self) -> [f64; 3] {
         [self.next_1d(), self.next_1d(), self.next_1d()]
+    }
+
+    /// Skips `n` numbers without computing them: the later numbers are the same
+    /// as if they had been drawn.
+    pub fn skip(&mut self, n: u64) {
+        self.dimension += n;
     }
 }
 
@@ -61,6 +87,14 @@ mod tests {
             .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn skip_is_drawing_and_discarding() {
+        let (mut a, mut b) = (Sampler::new(1, 2, 3), Sampler::new(1, 2, 3));
+        a.next_3d();
+        b.skip(3);
+        assert_eq!(a.next_1d(), b.next_1d());
     }
 
     #[test]
