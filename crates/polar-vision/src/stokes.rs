@@ -29,7 +29,8 @@ pub struct StokesArgs {
     pub out: PathBuf,
     /// Demosaicing method (error table and speed: README "Demosaicing error"):
     ///   residual    the default: edge-aware residual interpolation (Ahmed et al. 2017,
-    ///               Morimatsu et al. 2020); lowest error on edges and fine texture, ~2-3x bilinear's time
+    ///               Morimatsu et al. 2020); lowest error on edges and fine texture; 2-4x
+    ///               bilinear's demosaicing time (bilinear's fused SIMD path is faster still)
     ///   bilinear    polanalyser's COLOR_PolarMono, bit-exact; the fastest full-resolution
     ///               method: to match polanalyser/OpenCV, or when speed matters most
     ///   newton      Newton polynomial (Li et al. 2019): for comparison; beats bilinear on

@@ -55,16 +55,27 @@ impl Padded {
     /// Mirrors the `w x h` plane `f(x, y)`.
     fn new(w: usize, h: usize, f: impl Fn(usize, usize) -> f32 + Sync) -> Self {
         let stride = w + 2 * PAD;
+        let xs: Vec<usize> = (0..stride)
+            .map(|px| mirror(px as isize - PAD as isize, w))
+            .collect();
         let mut data = vec![0.0; stride * (h + 2 * PAD)];
         data.par_chunks_mut(stride)
             .enumerate()
             .for_each(|(py, row)| {
                 let y = mirror(py as isize - PAD as isize, h);
-                for (px, v) in row.iter_mut().enumerate() {
-                    *v = f(mirror(px as isize - PAD as isize, w), y);
+                for (v, &x) in row.iter_mut().zip(&xs) {
+                    *v = f(x, y);
                 }
             });
         Self { data, stride }
+    }
+
+    /// Row `y + dy` (image coordinates, `|dy| <= PAD`) with its margins: image column
+    /// `x` is at index `x + PAD`.
+    #[inline]
+    fn row(&self, y: usize, dy: isize) -> &[f32] {
+        let start = (y + PAD).wrapping_add_signed(dy) * self.stride;
+        &self.data[start..start + self.stride]
     }
 
     /// Value at `(x + dx, y + dy)`, `|dx|, |dy| <= PAD`.
@@ -75,24 +86,51 @@ impl Padded {
     }
 }
 
-/// Weight of the neighbour at `p + d`: inverse one-sided gradient of the mosaic from `p` toward `d`.
-#[inline]
-fn weight(raw: &Padded, x: usize, y: usize, (dx, dy): (isize, isize)) -> f32 {
-    let g = (raw.at(x, y, 2 * dx, 2 * dy) - raw.at(x, y, 0, 0)).abs()
-        + (raw.at(x, y, 3 * dx, 3 * dy) - raw.at(x, y, dx, dy)).abs();
-    1.0 / (WEIGHT_FLOOR + g)
+/// Rows `y − 3 ..= y + 3` of a padded plane, indexed `[dy + 3][x + PAD + dx]`.
+type Window<'a> = [&'a [f32]; 2 * PAD + 1];
+
+fn window(plane: &Padded, y: usize) -> Window<'_> {
+    std::array::from_fn(|k| plane.row(y, k as isize - PAD as isize))
 }
 
-/// Gradient-weighted mean of the residual over the neighbours at `p + d`, `d` in `dirs`.
+/// Value of a window at `(x + dx, y + dy)`.
 #[inline]
-fn interpolate(raw: &Padded, res: &Padded, x: usize, y: usize, dirs: &[(isize, isize)]) -> f32 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for &d in dirs {
-        let w = weight(raw, x, y, d);
-        num += w * res.at(x, y, d.0, d.1);
-        den += w;
-    }
-    num / den
+fn at(win: &Window<'_>, x: usize, dx: isize, dy: isize) -> f32 {
+    win[(PAD as isize + dy) as usize][(x + PAD).wrapping_add_signed(dx)]
+}
+
+/// `1 + g` for the neighbour at `p + d`, with `g` the one-sided gradient of the mosaic
+/// from `p` toward `d`; its inverse is the neighbour's weight.
+#[inline]
+fn spread(raw: &Window<'_>, x: usize, (dx, dy): (isize, isize)) -> f32 {
+    WEIGHT_FLOOR
+        + (at(raw, x, 2 * dx, 2 * dy) - at(raw, x, 0, 0)).abs()
+        + (at(raw, x, 3 * dx, 3 * dy) - at(raw, x, dx, dy)).abs()
+}
+
+/// Mean of the residual at `p ± d` with weights `1 / spread` (one division:
+/// `(r₊ s₋ + r₋ s₊) / (s₋ + s₊)`).
+#[inline]
+fn interpolate_pair(raw: &Window<'_>, res: &Window<'_>, x: usize, d: (isize, isize)) -> f32 {
+    let (sp, sm) = (spread(raw, x, d), spread(raw, x, (-d.0, -d.1)));
+    (at(res, x, d.0, d.1) * sm + at(res, x, -d.0, -d.1) * sp) / (sp + sm)
+}
+
+/// Mean of the residual at the four diagonal neighbours with weights `1 / spread`,
+/// multiplied through by the product of the spreads (one division).
+#[inline]
+fn interpolate_diagonal(raw: &Window<'_>, res: &Window<'_>, x: usize) -> f32 {
+    let s = DIAGONALS.map(|d| spread(raw, x, d));
+    let others = [
+        s[1] * s[2] * s[3],
+        s[0] * s[2] * s[3],
+        s[0] * s[1] * s[3],
+        s[0] * s[1] * s[2],
+    ];
+    let num: f32 = (0..4)
+        .map(|i| others[i] * at(res, x, DIAGONALS[i].0, DIAGONALS[i].1))
+        .sum();
+    num / others.iter().sum::<f32>()
 }
 
 const DIAGONALS: [(isize, isize); 4] = [(1, 1), (-1, 1), (1, -1), (-1, -1)];
@@ -109,16 +147,18 @@ const DIAGONALS: [(isize, isize); 4] = [(1, 1), (-1, 1), (1, -1), (-1, -1)];
 /// that would be a ±1 % checkerboard in S0.
 fn pair_gains(guide: &[f32], raw: &Padded, w: usize, h: usize) -> [f32; 2] {
     let top = raw.data.par_iter().copied().reduce(|| 0.0, f32::max);
-    let clipped = |x, y| {
-        (-2..=2isize)
-            .any(|dy| (-2..=2isize).any(|dx| dx * dx + dy * dy < 8 && raw.at(x, y, dx, dy) >= top))
-    };
     let (even, odd) = (2..h.saturating_sub(2))
         .into_par_iter()
         .map(|y| {
+            let rw = window(raw, y);
+            let clipped = |x| {
+                (-2..=2isize).any(|dy| {
+                    (-2..=2isize).any(|dx| dx * dx + dy * dy < 8 && at(&rw, x, dx, dy) >= top)
+                })
+            };
             let (mut e, mut o) = (0.0f64, 0.0f64);
             for x in (2 + (y & 1)..w.saturating_sub(2)).step_by(2) {
-                if clipped(x, y) {
+                if clipped(x) {
                     continue;
                 }
                 let k = y * w + x;
@@ -141,17 +181,14 @@ pub(crate) fn residual<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
     let (w, h) = raw.size();
     let src = raw.as_slice();
     let rawp = Padded::new(w, h, |x, y| src[y * w + x].into() as f32);
-    let guide_at = |x: usize, y: usize| {
-        let diag: f32 = DIAGONALS
-            .iter()
-            .map(|&(dx, dy)| rawp.at(x, y, dx, dy))
-            .sum();
-        0.5 * rawp.at(x, y, 0, 0) + 0.125 * diag
-    };
-    let mut guide: Vec<f32> = (0..w * h)
-        .into_par_iter()
-        .map(|k| guide_at(k % w, k / w))
-        .collect();
+    let mut guide = vec![0.0; w * h];
+    guide.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        let rw = window(&rawp, y);
+        for (x, g) in row.iter_mut().enumerate() {
+            let diag: f32 = DIAGONALS.iter().map(|&(dx, dy)| at(&rw, x, dx, dy)).sum();
+            *g = 0.5 * at(&rw, x, 0, 0) + 0.125 * diag;
+        }
+    });
     let gains = pair_gains(&guide, &rawp, w, h);
     guide.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, g) in row.iter_mut().enumerate() {
@@ -165,16 +202,15 @@ pub(crate) fn residual<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
         .par_chunks_mut(w)
         .enumerate()
         .for_each(|(y, row)| {
-            for (x, px) in row.iter_mut().enumerate() {
-                let g = guide[y * w + x];
-                px[channel_at(x, y)] = rawp.at(x, y, 0, 0);
-                for ((dx, dy), dirs) in [
-                    ((1, 0), &[(1, 0), (-1, 0)][..]),
-                    ((0, 1), &[(0, 1), (0, -1)][..]),
-                    ((1, 1), &DIAGONALS[..]),
+            let (rw, sw) = (window(&rawp, y), window(&resp, y));
+            for (x, (px, &g)) in row.iter_mut().zip(&guide[y * w..]).enumerate() {
+                px[channel_at(x, y)] = at(&rw, x, 0, 0);
+                for (c, r) in [
+                    (channel_at(x + 1, y), interpolate_pair(&rw, &sw, x, (1, 0))),
+                    (channel_at(x, y + 1), interpolate_pair(&rw, &sw, x, (0, 1))),
+                    (channel_at(x + 1, y + 1), interpolate_diagonal(&rw, &sw, x)),
                 ] {
-                    let r = interpolate(&rawp, &resp, x, y, dirs);
-                    px[channel_at(x + dx, y + dy)] = (g + r).max(0.0);
+                    px[c] = (g + r).max(0.0);
                 }
             }
         });
