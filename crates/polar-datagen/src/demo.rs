@@ -117,6 +117,7 @@ pub fn demo_params(width: u32, height: u32, spp: u32) -> SampleParams {
             albedo: [0.2, 0.7],
         },
         objects,
+        haze: None,
     }
 }
 

@@ -181,11 +181,6 @@ fn run(cli: Cli) -> Result<(), Error> {
                 progress,
             };
             prepare_output(&parsed, &text, &opts)?;
-            for f in parsed.families.iter() {
-                if let Some(why) = f.kind.pending_reason() {
-                    eprintln!("family '{}' ({}): {why}", f.name, f.kind.name());
-                }
-            }
             let summary = run_suite(&parsed, &opts, &RenderWorker)?;
             print!("{}", summary.table());
             println!(

@@ -61,6 +61,25 @@ pub struct SampleParams {
     pub background: BackgroundParams,
     /// Objects in the scene.
     pub objects: Vec<ObjectParams>,
+    /// The participating medium (haze family only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub haze: Option<HazeParams>,
+}
+
+/// A slab of haze over the ground: a homogeneous medium with a Henyey-Greenstein phase
+/// matrix with Rayleigh-like polarization, scaled by `1 - depolarization`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HazeParams {
+    /// Extinction coefficient sigma_t, 1/m.
+    pub extinction: f64,
+    /// Single-scattering albedo sigma_s / sigma_t.
+    pub albedo: f64,
+    /// Henyey-Greenstein asymmetry g.
+    pub asymmetry: f64,
+    /// Depolarization of the phase matrix, in [0, 1].
+    pub depolarization: f64,
+    /// Distance of the farthest object from the camera, m.
+    pub scene_depth: f64,
 }
 
 /// A camera on a sphere around the scene centre, looking at it, up = +y.
@@ -314,6 +333,41 @@ impl Draw<'_> {
         objects
     }
 
+    fn haze(&mut self) -> HazeParams {
+        HazeParams {
+            extinction: self.num("density"),
+            albedo: self.num("haze_albedo"),
+            asymmetry: self.num("haze_asymmetry"),
+            depolarization: self.num("haze_depolarization"),
+            scene_depth: self.num("scene_depth"),
+        }
+    }
+
+    /// Objects standing on the ground at depths spread geometrically from the camera distance
+    /// to `depth` (equal steps in log depth: as many near as far objects on screen), each at a
+    /// random lateral place in the field of view and 15 % of the view's width tall.
+    fn objects_in_depth(&mut self, camera: &CameraParams, depth: f64) -> Vec<ObjectParams> {
+        let n = self.int("objects").max(1);
+        let near = camera.distance.min(depth);
+        let half_field = (0.5 * camera.fov_deg.to_radians()).tan();
+        (0..n)
+            .map(|i| {
+                let t = (f64::from(i) + self.unit()) / f64::from(n);
+                let z = near * (depth / near).powf(t);
+                let size = 0.15 * z * half_field;
+                let x = (2.0 * self.unit() - 1.0) * 0.8 * z * half_field;
+                let name = self.pick("shape");
+                ObjectParams {
+                    shape: self.shape(&name),
+                    material: self.dielectric(),
+                    position: [x, size, -z],
+                    rotation_deg: [0; 3].map(|_| self.unit() * 360.0),
+                    size,
+                }
+            })
+            .collect()
+    }
+
     fn background(&mut self) -> BackgroundParams {
         match self.family.kind {
             FamilyKind::Transparent => {
@@ -359,17 +413,23 @@ pub fn draw_params(suite: &Suite, family: &Family, size: SizeName, index: u32) -
         ambient: d.num("ambient"),
     };
     let background = d.background();
-    let objects = if family.kind == FamilyKind::Haze {
-        Vec::new()
+    let (objects, haze, camera) = if family.kind == FamilyKind::Haze {
+        let haze = d.haze();
+        (
+            d.objects_in_depth(&camera, haze.scene_depth),
+            Some(haze),
+            camera,
+        )
     } else {
-        d.objects()
-    };
-    // Keep every object in view: the row's half-extent plus 20 % margin within the half field.
-    let extent: f64 = objects.iter().map(|o| 2.2 * o.size).sum();
-    let fit = 0.6 * extent / (0.5 * camera.fov_deg.to_radians()).tan();
-    let camera = CameraParams {
-        distance: camera.distance.max(fit),
-        ..camera
+        let objects = d.objects();
+        // Keep every object in view: the row's half-extent plus 20 % margin within the half field.
+        let extent: f64 = objects.iter().map(|o| 2.2 * o.size).sum();
+        let fit = 0.6 * extent / (0.5 * camera.fov_deg.to_radians()).tan();
+        let camera = CameraParams {
+            distance: camera.distance.max(fit),
+            ..camera
+        };
+        (objects, None, camera)
     };
     SampleParams {
         id: sample_id(&family.name, index),
@@ -385,6 +445,7 @@ pub fn draw_params(suite: &Suite, family: &Family, size: SizeName, index: u32) -
         light,
         background,
         objects,
+        haze,
     }
 }
 
@@ -448,6 +509,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn haze_objects_spread_from_the_camera_distance_to_the_scene_depth() {
+        let text = include_str!("../../../datasets-synth/suites/standard.toml");
+        let s = Suite::parse(text).unwrap();
+        let f = s
+            .families
+            .iter()
+            .find(|f| f.kind == FamilyKind::Haze)
+            .unwrap();
+        for i in 0..50 {
+            let p = draw_params(&s, f, SizeName::Full, i);
+            let h = p.haze.expect("haze family draws a medium");
+            let [lo, hi] = f.range("density");
+            assert!((lo..=hi).contains(&h.extinction), "{h:?}");
+            assert!((0.0..=1.0).contains(&h.albedo) && h.asymmetry.abs() < 1.0);
+            let depths: Vec<f64> = p.objects.iter().map(|o| -o.position[2]).collect();
+            assert!(!depths.is_empty());
+            for (k, z) in depths.iter().enumerate() {
+                // Strata in log depth: object k lies in the k-th of n equal log-depth bins.
+                let t = (z / p.camera.distance).ln() / (h.scene_depth / p.camera.distance).ln();
+                let n = depths.len() as f64;
+                assert!(
+                    t >= k as f64 / n - 1e-9 && t <= (k + 1) as f64 / n + 1e-9,
+                    "{t}"
+                );
+            }
+        }
+        let clear = draw_params(&s, &s.families[0], SizeName::Ci, 0);
+        assert!(clear.haze.is_none());
     }
 
     #[test]

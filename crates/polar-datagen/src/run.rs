@@ -73,12 +73,11 @@ pub trait SampleWorker: Sync {
     fn produce(&self, params: &SampleParams, dir: &Path) -> Result<WorkReport, Error>;
 }
 
-/// Every sample of the suite at `size`, in global order, and the families skipped as pending.
+/// Every sample of the suite at `size`, in global order.
 pub fn plan(suite: &Suite, size: SizeName) -> Vec<SampleParams> {
     suite
         .families
         .iter()
-        .filter(|f| f.kind.pending_reason().is_none())
         .flat_map(|f| (0..f.size(size).count).map(move |i| draw_params(suite, f, size, i)))
         .collect()
 }
@@ -123,8 +122,6 @@ pub struct FamilySummary {
     pub render_seconds: f64,
     /// Light-transport models used.
     pub models: BTreeSet<String>,
-    /// Why the family was skipped, if it was.
-    pub pending: Option<String>,
 }
 
 /// The outcome of a suite run.
@@ -286,7 +283,6 @@ fn summary_skeleton(suite: &Suite, jobs: &[SampleParams], kept: &[ManifestEntry]
         let mut f = FamilySummary {
             kind: fam.kind.name().into(),
             expected: jobs.iter().filter(|p| p.family == fam.name).count(),
-            pending: fam.kind.pending_reason().map(str::to_owned),
             ..FamilySummary::default()
         };
         for e in kept.iter().filter(|e| e.params.family == fam.name) {
@@ -311,10 +307,10 @@ impl RunSummary {
             let Some(f) = self.families.get(name) else {
                 continue;
             };
-            let model = match &f.pending {
-                Some(why) => format!("pending: {why}"),
-                None if f.models.is_empty() => "-".into(),
-                None => f.models.iter().cloned().collect::<Vec<_>>().join(", "),
+            let model = if f.models.is_empty() {
+                "-".into()
+            } else {
+                f.models.iter().cloned().collect::<Vec<_>>().join(", ")
             };
             t.push_str(&format!(
                 "{:<16} {:<12} {:>8} {:>8} {:>6} {:>10.1}  {}\n",

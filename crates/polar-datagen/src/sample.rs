@@ -118,7 +118,8 @@ fn io_err(id: &str) -> impl Fn(polar_io::Error) -> Error + '_ {
 }
 
 /// Writes meta.json, raw.png, stokes.exr, polarizers.exr (the noiseless full-resolution
-/// images behind the four micro-polarizers) and gt/ for one render into `dir`.
+/// images behind the four micro-polarizers) and gt/ (with clear.exr and transmission.exr when
+/// the scene has a medium) for one render into `dir`.
 /// `scene_meta` is recorded verbatim as `meta.scene` (the sample parameters or the scene file).
 /// The sensor noise is seeded from the scene's render seed.
 pub fn write_sample(
@@ -161,6 +162,15 @@ pub fn write_sample(
         .map_err(io_err(id))?;
     polar_io::write_gray8_png(gt.join("material.png"), &out.material).map_err(io_err(id))?;
     polar_io::write_gray8_png(gt.join("transparent.png"), &out.transparent).map_err(io_err(id))?;
+    // Samples with a medium: the medium-free view and the transmittance, for dehazing.
+    for (name, image) in [
+        (polar_io::files::GT_CLEAR, &out.clear),
+        (polar_io::files::GT_TRANSMISSION, &out.transmission),
+    ] {
+        if let Some(image) = image {
+            polar_io::write_exr(dir.join(name), image, polar_io::Y_CHANNEL).map_err(io_err(id))?;
+        }
+    }
     let meta = meta(
         scene,
         out,

@@ -1,16 +1,18 @@
 //! From sample parameters to a `polar_render::Scene`: camera on a sphere around the objects,
-//! a sun plus a uniform sky, a ground plane (and a textured backdrop for glass), objects in a row.
+//! a sun plus a uniform sky, a ground plane (and a textured backdrop for glass), objects in a row;
+//! for haze, a low camera looking over objects spread in depth through a slab of haze.
 
 use polar_bsdf::{
     Checkerboard, ConductorParams, DielectricParams, LambertianParams, Material, Metal,
     PlasticParams, Roughness, Texture,
 };
+use polar_optics::scatter::PhaseFunction;
 use polar_render::scene::Vec3;
 use polar_render::shapes::{cube, rectangle, superquadric, torus, transform};
-use polar_render::{Camera, Emission, Geometry, Light, Scene, Shape};
+use polar_render::{Camera, Emission, Geometry, Light, Medium, Scene, Shape};
 
 use crate::mesh::{blob, extrusion};
-use crate::params::{MaterialParams, ObjectParams, SampleParams, ShapeParams};
+use crate::params::{HazeParams, MaterialParams, ObjectParams, SampleParams, ShapeParams};
 use crate::suite::FamilyKind;
 
 /// Tessellation of curved meshes: 48 segments keep the chord error below 0.1 % of the radius.
@@ -26,19 +28,58 @@ fn direction(elevation_deg: f64, azimuth_deg: f64) -> Vec3 {
     Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos())
 }
 
-/// Builds the scene of one sample.
-pub fn build_scene(p: &SampleParams) -> Scene {
-    let height = p.objects.iter().map(|o| o.size).fold(0.5, f64::max);
-    let target = Vec3::new(0.0, height, 0.0);
-    let camera = Camera {
-        position: target + p.camera.distance * direction(p.camera.elevation_deg, 0.0),
-        look_at: target,
+/// The camera: on a sphere around the objects, or for haze at eye height (the size of the
+/// nearest object) looking toward the far end, pitched down by `elevation_deg`.
+fn camera(p: &SampleParams) -> Camera {
+    let (position, look_at) = match &p.haze {
+        Some(h) => {
+            let eye = Vec3::new(0.0, 0.15 * p.camera.distance * tan_half(p), 0.0);
+            (
+                eye,
+                eye + h.scene_depth * direction(-p.camera.elevation_deg, 180.0),
+            )
+        }
+        None => {
+            let height = p.objects.iter().map(|o| o.size).fold(0.5, f64::max);
+            let target = Vec3::new(0.0, height, 0.0);
+            let position = target + p.camera.distance * direction(p.camera.elevation_deg, 0.0);
+            (position, target)
+        }
+    };
+    Camera {
+        position,
+        look_at,
         up: Vec3::y(),
         fov_deg: p.camera.fov_deg,
         width: p.width as usize,
         height: p.height as usize,
-    };
-    let mut scene = Scene::new(camera);
+    }
+}
+
+fn tan_half(p: &SampleParams) -> f64 {
+    (0.5 * p.camera.fov_deg.to_radians()).tan()
+}
+
+/// Haze fills a box three scene depths wide and deep around the camera and half a scene
+/// depth high, so that every view ray crosses at least one scene depth of it.
+fn haze_medium(h: &HazeParams) -> Medium {
+    let d = h.scene_depth;
+    Medium {
+        bounds_min: Vec3::new(-3.0 * d, -0.01 * d, -3.0 * d),
+        bounds_max: Vec3::new(3.0 * d, 0.5 * d, 3.0 * d),
+        sigma_s: h.albedo * h.extinction,
+        sigma_a: (1.0 - h.albedo) * h.extinction,
+        phase: PhaseFunction::HenyeyGreenstein {
+            g: h.asymmetry,
+            depolarization: h.depolarization,
+        },
+        density: None,
+    }
+}
+
+/// Builds the scene of one sample.
+pub fn build_scene(p: &SampleParams) -> Scene {
+    let mut scene = Scene::new(camera(p));
     scene.settings.spp = p.spp;
     scene.settings.seed = p.seed;
     scene.settings.max_depth = MAX_DEPTH;
@@ -50,6 +91,7 @@ pub fn build_scene(p: &SampleParams) -> Scene {
         emission: Emission::unpolarized(p.light.intensity),
     });
     add_ground(&mut scene, p);
+    scene.medium = p.haze.as_ref().map(haze_medium);
     for (i, o) in p.objects.iter().enumerate() {
         let m = scene.add_material(&format!("object{i}"), material(&o.material));
         scene.shapes.push(Shape::new(geometry(o), m));
@@ -72,7 +114,9 @@ fn albedo_texture(p: &SampleParams) -> Texture {
 fn add_ground(scene: &mut Scene, p: &SampleParams) {
     let lambert = |albedo| Material::Lambertian(LambertianParams { albedo });
     let ground = scene.add_material("ground", lambert(Texture::Constant(p.background.albedo[0])));
-    let floor = rectangle().transformed(&transform([0.0; 3], [-90.0, 0.0, 0.0], [PLANE; 3]));
+    // The ground reaches past the haze box, whose far walls are then hidden behind it.
+    let half = p.haze.as_ref().map_or(PLANE, |h| 4.0 * h.scene_depth);
+    let floor = rectangle().transformed(&transform([0.0; 3], [-90.0, 0.0, 0.0], [half; 3]));
     scene.shapes.push(Shape {
         background: true,
         ..Shape::new(Geometry::Mesh(floor), ground)
@@ -191,11 +235,7 @@ mod tests {
     fn every_drawn_scene_of_the_standard_suite_validates() {
         let text = include_str!("../../../datasets-synth/suites/standard.toml");
         let suite = Suite::parse(text).unwrap();
-        for f in suite
-            .families
-            .iter()
-            .filter(|f| f.kind.pending_reason().is_none())
-        {
+        for f in &suite.families {
             for i in 0..60 {
                 let p = draw_params(&suite, f, SizeName::Ci, i);
                 if let Err(e) = build_scene(&p).validate() {

@@ -64,21 +64,11 @@ pub enum FamilyKind {
     Material,
     /// Transparent objects: glass of several shapes and thicknesses over textured backgrounds.
     Transparent,
-    /// Haze: needs participating media (issue 5), which the renderer does not have yet.
+    /// Haze: objects spread in depth in a slab of polarizing haze, for dehazing.
     Haze,
 }
 
 impl FamilyKind {
-    /// Why this kind cannot be rendered yet, if it cannot.
-    pub fn pending_reason(self) -> Option<&'static str> {
-        match self {
-            FamilyKind::Haze => Some(
-                "needs participating-media support in the renderer (issue 5), not yet built; skipped",
-            ),
-            _ => None,
-        }
-    }
-
     /// The snake_case name used in suite files.
     pub fn name(self) -> &'static str {
         match self {
@@ -372,36 +362,91 @@ const TRANSPARENT: &[ParamSpec] = &[
     p("object_size", [0.5, 0.9], [0.05, 5.0], "object radius, m"),
 ];
 
+/// Haze: objects spread in depth from `camera_distance` to `scene_depth` in a slab of haze,
+/// seen by a camera looking along the ground; the sun is the key light.
 const HAZE: &[ParamSpec] = &[
     p(
-        "density",
-        [0.01, 0.3],
-        [0.0, 10.0],
-        "extinction coefficient, 1/m",
+        "camera_distance",
+        [3.0, 6.0],
+        [0.5, 100.0],
+        "depth of the nearest object, m",
     ),
     p(
-        "sun_elevation_deg",
+        "camera_elevation_deg",
+        [0.0, 4.0],
+        [-10.0, 45.0],
+        "downward pitch of the view, degrees",
+    ),
+    p(
+        "light_elevation_deg",
         [5.0, 60.0],
         [0.0, 90.0],
         "sun elevation, degrees",
     ),
     p(
-        "scene_depth",
-        [20.0, 200.0],
-        [1.0, 10000.0],
-        "depth of the scene, m",
+        "density",
+        [0.005, 0.04],
+        [0.0, 10.0],
+        "haze extinction coefficient sigma_t, 1/m (0.04: visibility ~100 m)",
     ),
+    p(
+        "haze_albedo",
+        [0.85, 1.0],
+        [0.0, 1.0],
+        "single-scattering albedo sigma_s / sigma_t of the haze",
+    ),
+    p(
+        "haze_asymmetry",
+        [0.0, 0.6],
+        [-0.95, 0.95],
+        "Henyey-Greenstein g of the haze (0 isotropic, aerosols 0.6-0.8)",
+    ),
+    p(
+        "haze_depolarization",
+        [0.0, 0.5],
+        [0.0, 1.0],
+        "depolarization of the haze phase matrix (0: Rayleigh-like, 1: none)",
+    ),
+    p(
+        "scene_depth",
+        [20.0, 150.0],
+        [1.0, 10000.0],
+        "distance of the farthest object, m",
+    ),
+    p(
+        "objects",
+        [3.0, 6.0],
+        [1.0, 16.0],
+        "number of objects (integer)",
+    ),
+    p(
+        "ior",
+        [1.4, 1.7],
+        [1.0, 3.0],
+        "object coat index of refraction",
+    ),
+    p(
+        "roughness",
+        [0.05, 0.5],
+        [0.0, 1.0],
+        "object GGX roughness alpha",
+    ),
+    p("albedo", [0.1, 0.8], [0.0, 1.0], "object diffuse albedo"),
 ];
 
 /// The numeric parameters of a kind: common camera/light ones, the kind's own, then shape ones.
+/// A kind may redefine a common key (default range, limits and meaning): its own spec wins.
 pub fn param_specs(kind: FamilyKind) -> Vec<ParamSpec> {
     let (own, geometry) = match kind {
         FamilyKind::Shape => (SHAPE, GEOMETRY),
         FamilyKind::Material => (MATERIAL, GEOMETRY),
         FamilyKind::Transparent => (TRANSPARENT, GEOMETRY),
-        FamilyKind::Haze => (HAZE, &[][..]),
+        FamilyKind::Haze => (HAZE, GEOMETRY),
     };
-    COMMON.iter().chain(own).chain(geometry).copied().collect()
+    let common = COMMON
+        .iter()
+        .filter(|c| !own.iter().any(|o| o.key == c.key));
+    common.chain(own).chain(geometry).copied().collect()
 }
 
 const SHAPES: &[&str] = &["sphere", "superquadric", "blob", "torus", "extrusion"];
@@ -434,6 +479,7 @@ pub fn choice_specs(kind: FamilyKind) -> &'static [ChoiceSpec] {
             "metal of `metal` objects (complex index at 550 nm)",
         ),
     ];
+    const HAZE_C: &[ChoiceSpec] = &[c("shape", SHAPES, "procedural shape of each object")];
     const TRANSPARENT_C: &[ChoiceSpec] = &[
         c("shape", GLASS_SHAPES, "shape of each glass object"),
         c(
@@ -446,7 +492,7 @@ pub fn choice_specs(kind: FamilyKind) -> &'static [ChoiceSpec] {
         FamilyKind::Shape => SHAPE_C,
         FamilyKind::Material => MATERIAL_C,
         FamilyKind::Transparent => TRANSPARENT_C,
-        FamilyKind::Haze => &[],
+        FamilyKind::Haze => HAZE_C,
     }
 }
 
@@ -680,11 +726,5 @@ ranges = { ior = [1.4, 1.6] }
             "kind = \"shape\"\nchoices = { shape = [\"cube\"] }",
         );
         assert!(err_of(&with_choice).contains("'cube'"));
-    }
-
-    #[test]
-    fn haze_is_accepted_but_pending() {
-        assert!(FamilyKind::Haze.pending_reason().unwrap().contains("media"));
-        assert!(FamilyKind::Shape.pending_reason().is_none());
     }
 }

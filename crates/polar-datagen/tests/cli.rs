@@ -249,28 +249,8 @@ fn bad_suite_files_and_outputs_fail_before_any_work() {
 }
 
 #[test]
-fn haze_family_is_reported_pending_and_demo_writes_a_sample_with_pictures() {
+fn demo_writes_a_sample_with_pictures() {
     let t = tempfile::tempdir().unwrap();
-    let suite = t.path().join("haze.toml");
-    let text = std::fs::read_to_string(TINY).unwrap()
-        + "\n[[family]]\nname = \"fog\"\nkind = \"haze\"\nci = { count = 2, width = 16, height = 16, spp = 1 }\nfull = { count = 2, width = 16, height = 16, spp = 1 }\n";
-    std::fs::write(&suite, text).unwrap();
-    let r = run_ok(&[
-        "suite",
-        s(&suite),
-        "--out",
-        s(&t.path().join("d")),
-        "--quiet",
-    ]);
-    let table = String::from_utf8_lossy(&r.stdout);
-    let fog = table
-        .lines()
-        .find(|l| l.starts_with("fog"))
-        .unwrap_or_default();
-    assert!(fog.contains("pending") && fog.contains("media"), "{table}");
-    assert!(String::from_utf8_lossy(&r.stderr).contains("participating-media"));
-    assert!(!t.path().join("d/fog-00000").exists());
-
     let demo = t.path().join("demo");
     run_ok(&["demo", "--out", s(&demo), "--size", "32", "--spp", "2"]);
     for f in [
@@ -408,4 +388,58 @@ fn polarizer_images_decode_to_the_rendered_stokes() {
         checked += 1;
     }
     assert!(checked > 20, "only {checked} polarized pixels to check");
+}
+
+#[test]
+fn haze_samples_carry_the_clear_view_and_the_transmission_map() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = t.path().join("haze.toml");
+    std::fs::write(
+        &suite,
+        r#"version = 1
+name = "haze-test"
+seed = 3
+[[noise]]
+name = "clean"
+full_well_e = 60000
+read_noise_e = 0.0
+bits = 16
+shot_noise = false
+[[family]]
+name = "haze"
+kind = "haze"
+ci = { count = 2, width = 24, height = 16, spp = 4 }
+full = { count = 2, width = 24, height = 16, spp = 4 }
+ranges = { density = [0.03, 0.04], scene_depth = [40.0, 60.0] }
+"#,
+    )
+    .unwrap();
+    let out = t.path().join("data");
+    let run = run_ok(&["suite", s(&suite), "--out", s(&out), "--quiet"]);
+    // The Henyey-Greenstein haze polarizes linearly and never couples S3.
+    let table = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        table.contains("haze") && table.contains("Linear"),
+        "{table}"
+    );
+    for id in manifest_ids(&out) {
+        // read_sample checks transmission in [0, 1] and clear S0 finite and >= 0.
+        let sample = polar_io::read_sample(out.join(&id)).unwrap();
+        let transmission = sample.gt.transmission.expect("gt/transmission.exr");
+        let clear = sample.gt.clear.expect("gt/clear.exr");
+        let hazy = sample.stokes.expect("stokes.exr").channel(0);
+        // Sight lines cross 40-60 m of haze with sigma_t >= 0.03 /m: transmittance well below 1.
+        let least = transmission.as_slice().iter().copied().fold(1.0, f32::min);
+        assert!(least < 0.5, "{id}: least transmittance {least}");
+        let differs = hazy
+            .as_slice()
+            .iter()
+            .zip(clear.as_slice())
+            .filter(|(h, c)| (*h - *c).abs() > 1e-3 * c.abs().max(1e-3))
+            .count();
+        assert!(
+            differs > hazy.as_slice().len() / 2,
+            "{id}: haze changed only {differs} pixels"
+        );
+    }
 }

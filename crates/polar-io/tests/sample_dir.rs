@@ -237,7 +237,12 @@ fn invalid_ground_truth_values_are_refused_on_write() {
     let mut over_one = full_sample();
     over_one.gt.transmission.as_mut().unwrap().as_mut_slice()[2] = 1.01;
     let mut nan_transmission = full_sample();
-    nan_transmission.gt.transmission.as_mut().unwrap().as_mut_slice()[0] = f32::NAN;
+    nan_transmission
+        .gt
+        .transmission
+        .as_mut()
+        .unwrap()
+        .as_mut_slice()[0] = f32::NAN;
     for (s, file) in [
         (over_one, files::GT_TRANSMISSION),
         (nan_transmission, files::GT_TRANSMISSION),
