@@ -35,6 +35,9 @@ step "Mitsuba 3: Stokes frame experiment"
 step "Mitsuba 3: polarized Rayleigh phase function in volpath"
 "$py" tools/mitsuba/rayleigh_check.py --threads 2
 
+step "Mie scattering vs miepython"
+"$py" tools/mie_check.py
+
 step "BSDF Mueller matrices vs Mitsuba 3"
 "$py" tools/bsdf_crosscheck.py
 
