@@ -101,7 +101,8 @@ struct GroundTruth {
 }
 
 /// Renders `scene` with the cheapest exact transport (or `opts.force_model`),
-/// using the current rayon thread pool. `progress(done, total)` is called after each tile.
+/// using the current rayon thread pool. `progress(done, total)` is called after each tile
+/// (with a medium, a second round follows for the medium-free `clear` render).
 /// The result is bit-identical for the same scene and seed whatever the thread count.
 pub fn render(
     scene: &Scene,

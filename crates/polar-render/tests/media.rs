@@ -529,3 +529,48 @@ fn sky_sun_lights_a_white_ground() {
     let err = render(&scene, &RenderOptions::default(), &|_, _| {}).unwrap_err();
     assert!(err.to_string().contains("at most one"), "{err}");
 }
+
+#[test]
+fn camera_inside_the_medium_sees_an_attenuated_lamp() {
+    // Camera at the centre of an absorbing box [-2, 2]³ (σ_a = 0.4) facing an emissive
+    // rectangle (radiance 1, facing the camera) 1.5 units away: S0 = transmission =
+    // e^{−0.4 · 1.5 / cos} per pixel (2° fov: cos > 0.9998, checked at the centre).
+    let mut medium = unit_box(0.0, 0.4, PhaseFunction::Rayleigh);
+    medium.bounds_min = V3::repeat(-2.0);
+    medium.bounds_max = V3::repeat(2.0);
+    let mut scene = scene_with(
+        Camera {
+            position: V3::zeros(),
+            look_at: V3::new(0.0, 0.0, -1.0),
+            ..camera(0.0, 2.0, 8)
+        },
+        medium,
+        2,
+    );
+    let lamp = polar_render::shapes::rectangle().transformed(&polar_render::shapes::transform(
+        [0.0, 0.0, -1.5],
+        [0.0; 3],
+        [1.0; 3],
+    ));
+    scene.shapes.push(Shape {
+        geometry: Geometry::Mesh(lamp),
+        material: None,
+        emission: Some(Emission::unpolarized(1.0)),
+        background: true,
+    });
+    let out = run(&scene, None);
+    let expected = (-0.4_f64 * 1.5).exp();
+    let tr = out.transmission.as_ref().expect("transmission");
+    assert!((f64::from(tr.pixel(4, 4)[0]) - expected).abs() < 1e-4);
+    for (s, t) in out.stokes.pixels().iter().zip(tr.pixels()) {
+        assert!(
+            (s[0] - t[0]).abs() < 1e-4,
+            "S0 {} vs transmission {}",
+            s[0],
+            t[0]
+        );
+    }
+    // Without the medium the lamp shows its full radiance.
+    let clear = out.clear.as_ref().expect("clear");
+    assert!(clear.pixels().iter().all(|p| (p[0] - 1.0).abs() < 1e-6));
+}
