@@ -1,12 +1,14 @@
 //! From sample parameters to a `polar_render::Scene`: camera on a sphere around the objects,
 //! a sun plus a uniform sky, a ground plane (and a textured backdrop for glass), objects in a row;
-//! for haze, a low camera looking over objects spread in depth through a slab of haze.
+//! for haze, a low camera looking over objects spread in depth through a slab of haze under a
+//! polarized Rayleigh sky.
 
 use polar_bsdf::{
     Checkerboard, ConductorParams, DielectricParams, LambertianParams, Material, Metal,
     PlasticParams, Roughness, Texture,
 };
 use polar_optics::scatter::PhaseFunction;
+use polar_optics::sky::RayleighSky;
 use polar_render::scene::Vec3;
 use polar_render::shapes::{cube, rectangle, superquadric, torus, transform};
 use polar_render::{Camera, Emission, Geometry, Light, Medium, Scene, Shape};
@@ -77,19 +79,38 @@ fn haze_medium(h: &HazeParams) -> Medium {
     }
 }
 
+/// Vertical optical depth of the Rayleigh sky over haze: the Earth's at 550 nm.
+const SKY_OPTICAL_DEPTH: f64 = 0.1;
+
+/// A sun and a uniform sky (`ambient`); for haze, outdoors, the polarized single-scattering
+/// Rayleigh sky with its own (attenuated) sun instead.
+fn lights(p: &SampleParams) -> Vec<Light> {
+    let sun = direction(p.light.elevation_deg, p.light.azimuth_deg);
+    if p.haze.is_some() {
+        let sky = RayleighSky {
+            sun_direction: sun,
+            up: Vec3::y(),
+            optical_depth: SKY_OPTICAL_DEPTH,
+            sun_irradiance: p.light.intensity,
+        };
+        return vec![Light::Sky(sky)];
+    }
+    vec![
+        Light::Environment(Emission::unpolarized(p.light.ambient)),
+        Light::Sun {
+            direction: sun,
+            emission: Emission::unpolarized(p.light.intensity),
+        },
+    ]
+}
+
 /// Builds the scene of one sample.
 pub fn build_scene(p: &SampleParams) -> Scene {
     let mut scene = Scene::new(camera(p));
     scene.settings.spp = p.spp;
     scene.settings.seed = p.seed;
     scene.settings.max_depth = MAX_DEPTH;
-    scene
-        .lights
-        .push(Light::Environment(Emission::unpolarized(p.light.ambient)));
-    scene.lights.push(Light::Sun {
-        direction: direction(p.light.elevation_deg, p.light.azimuth_deg),
-        emission: Emission::unpolarized(p.light.intensity),
-    });
+    scene.lights.extend(lights(p));
     add_ground(&mut scene, p);
     scene.medium = p.haze.as_ref().map(haze_medium);
     for (i, o) in p.objects.iter().enumerate() {
