@@ -6,24 +6,13 @@ use polar_bsdf::{LambertianParams, Material, Texture};
 use polar_optics::scatter::PhaseFunction;
 use polar_optics::stokes::{aolp, dolp};
 use polar_render::{
-    Camera, DensityGrid, Emission, Geometry, Light, Medium, Polarization, RenderOptions,
-    RenderOutput, Scene, Shape, render,
+    Camera, DensityGrid, Emission, Geometry, Light, Medium, Polarization, RenderOptions, Scene,
+    Shape, render,
 };
 use std::f64::consts::PI;
 
-type V3 = nalgebra::Vector3<f64>;
-
-/// A camera on +z at `distance` looking at the origin.
-fn camera(distance: f64, fov_deg: f64, size: usize) -> Camera {
-    Camera {
-        position: V3::new(0.0, 0.0, distance),
-        look_at: V3::zeros(),
-        up: V3::y(),
-        fov_deg,
-        width: size,
-        height: size,
-    }
-}
+mod common;
+use common::{V3, bits, camera, run, run_on_threads};
 
 /// The medium filling `[-1, 1]³`.
 fn unit_box(sigma_s: f64, sigma_a: f64, phase: PhaseFunction) -> Medium {
@@ -50,10 +39,6 @@ fn scene_with(cam: Camera, medium: Medium, spp: u32) -> Scene {
     scene.medium = Some(medium);
     scene.settings.spp = spp;
     scene
-}
-
-fn run(scene: &Scene, model: Option<Polarization>) -> RenderOutput {
-    render(scene, &RenderOptions { force_model: model }, &|_, _| {}).expect("render")
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> (f64, usize) {
@@ -371,24 +356,9 @@ fn linear_transport_matches_full_in_a_rayleigh_medium() {
 #[test]
 fn hazy_render_is_bit_identical_across_thread_counts_and_has_ground_truth() {
     let s = hazy_sphere(Some(constant_grid(0.7)));
-    let pool = |n| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .expect("pool")
-    };
-    let one = pool(1).install(|| run(&s, None));
-    let two = pool(2).install(|| run(&s, None));
-    let bits = |o: &RenderOutput| {
-        let clear = o.clear.as_ref().expect("clear");
-        o.stokes
-            .as_slice()
-            .iter()
-            .chain(clear.as_slice())
-            .map(|v| v.to_bits())
-            .collect::<Vec<_>>()
-    };
-    assert_eq!(bits(&one), bits(&two));
+    let one = run_on_threads(&s, 1);
+    assert!(one.clear.is_some());
+    assert_eq!(bits(&one), bits(&run_on_threads(&s, 2)));
     // The clear image is the medium-free render of the same view.
     let mut no_medium = s.clone();
     no_medium.medium = None;

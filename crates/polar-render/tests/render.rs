@@ -7,7 +7,8 @@ use polar_render::{
     render,
 };
 
-type V3 = nalgebra::Vector3<f64>;
+mod common;
+use common::{V3, bits, run, run_on_threads};
 
 fn lambertian(albedo: f64) -> Material {
     Material::Lambertian(LambertianParams {
@@ -66,10 +67,6 @@ fn scene(object: Material) -> Scene {
         emission: Emission::unpolarized(2.0),
     });
     scene
-}
-
-fn run(scene: &Scene, model: Option<Polarization>) -> RenderOutput {
-    render(scene, &RenderOptions { force_model: model }, &|_, _| {}).expect("render")
 }
 
 /// Largest difference over all pixels and the first `channels` channels, relative to max(1, |value|).
@@ -175,22 +172,8 @@ fn output_is_bit_identical_across_thread_counts() {
         roughness: Roughness::Isotropic(0.15),
     });
     let s = scene(plastic);
-    let pool = |n| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .expect("pool")
-    };
-    let one = pool(1).install(|| run(&s, None));
-    let three = pool(3).install(|| run(&s, None));
-    let bits = |o: &RenderOutput| {
-        o.stokes
-            .as_slice()
-            .iter()
-            .map(|v| v.to_bits())
-            .collect::<Vec<_>>()
-    };
-    assert_eq!(bits(&one), bits(&three));
+    let one = run_on_threads(&s, 1);
+    assert_eq!(bits(&one), bits(&run_on_threads(&s, 3)));
     let mut other_seed = s.clone();
     other_seed.settings.seed += 1;
     assert_ne!(

@@ -8,18 +8,8 @@ use polar_render::{
 };
 use std::f64::consts::PI;
 
-type V3 = nalgebra::Vector3<f64>;
-
-fn camera(distance: f64, fov_deg: f64, size: usize) -> Camera {
-    Camera {
-        position: V3::new(0.0, 0.0, distance),
-        look_at: V3::zeros(),
-        up: V3::y(),
-        fov_deg,
-        width: size,
-        height: size,
-    }
-}
+mod common;
+use common::{V3, camera};
 
 fn sphere_scene(cam: Camera, material: Material, env: f64) -> Scene {
     let mut scene = Scene::new(cam);
