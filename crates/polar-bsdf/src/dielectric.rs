@@ -35,13 +35,13 @@ impl Dielectric {
         let etap = self.etap(wo);
         let wr = reflect_z(wo);
         let fresnel = fresnel_amplitudes(wo.z.abs(), etap.into());
-        let r_mueller = from_sp_frame(&fresnel.reflection_mueller(), &V3::z(), wo, &wr);
+        let r_mueller = from_sp_frame(&fresnel.reflection_block(), &V3::z(), wo, &wr);
         let r = r_mueller[(0, 0)];
         let n = V3::z() * wo.z.signum();
         match refract(wo, &n, etap) {
             Some(wt) if u >= r => {
-                let t = from_sp_frame(&fresnel.transmission_mueller(), &V3::z(), wo, &wt)
-                    / (etap * etap);
+                let t =
+                    from_sp_frame(&fresnel.transmission_block(), &V3::z(), wo, &wt) / (etap * etap);
                 let pt = 1.0 - r;
                 Some(BsdfSample {
                     wi: wt,

@@ -3,8 +3,9 @@
 //! Fresnel Mueller matrix into the implicit Stokes bases of the BSDF interface.
 
 use nalgebra::Vector3;
+use polar_optics::frame::{double_angle, rotate_columns, rotate_rows};
 use polar_optics::fresnel::fresnel_amplitudes;
-use polar_optics::{Mueller, rotate_mueller_basis, stokes_basis};
+use polar_optics::{BlockDiagonal, Mueller, Stokes, rotate_stokes, stokes_basis};
 use std::f64::consts::{FRAC_1_PI, PI};
 
 /// Local-frame vector.
@@ -69,43 +70,67 @@ pub(crate) fn s_axis(normal: &V3, k: &V3) -> V3 {
     }
 }
 
+/// The two basis changes that take a matrix with input x axis `s_in` (light
+/// along `k_in`) and output x axis `s_out` (light along `k_out`) into the
+/// interface's bases `stokes_basis(k_in)` and `stokes_basis(k_out)`, as
+/// `(cos 2θ, sin 2θ)`: `(output, input)` for `rotator(output) · M · rotator(input)`.
+#[inline]
+fn bsdf_rotations(k_in: &V3, s_in: &V3, k_out: &V3, s_out: &V3) -> ((f64, f64), (f64, f64)) {
+    (
+        double_angle(k_out, s_out, &stokes_basis(k_out)),
+        double_angle(k_in, &stokes_basis(k_in), s_in),
+    )
+}
+
 /// Re-expresses a Mueller matrix given with input x axis `s_in` (light along
 /// `k_in`) and output x axis `s_out` (light along `k_out`) in the interface's
 /// bases: `stokes_basis(k_in)` and `stokes_basis(k_out)`.
 pub(crate) fn to_bsdf_bases(m: &Mueller, k_in: &V3, s_in: &V3, k_out: &V3, s_out: &V3) -> Mueller {
-    rotate_mueller_basis(
-        m,
-        k_in,
-        s_in,
-        &stokes_basis(k_in),
-        k_out,
-        s_out,
-        &stokes_basis(k_out),
-    )
+    let (out, inp) = bsdf_rotations(k_in, s_in, k_out, s_out);
+    rotate_columns(&rotate_rows(m, out), inp)
+}
+
+/// [`to_bsdf_bases`] of the rank-one matrix `col · rowᵀ` (a depolarizing element
+/// between two polarizing ones): rotating the two vectors instead of the product's
+/// rows and columns takes 8 multiplications instead of 32. The row is a column
+/// rotated by `−θ`: `(rowᵀ · R(θ))ᵀ = R(−θ) · row`.
+pub(crate) fn rank_one_to_bsdf_bases(
+    col: &Stokes,
+    row: &Stokes,
+    k_in: &V3,
+    s_in: &V3,
+    k_out: &V3,
+    s_out: &V3,
+) -> Mueller {
+    let (out, (ci, si)) = bsdf_rotations(k_in, s_in, k_out, s_out);
+    rotate_stokes(col, out) * rotate_stokes(row, (ci, -si)).transpose()
 }
 
 /// Fresnel reflection at the (micro)normal `m` of light arriving along `-wi` and
 /// leaving along `wo`, for relative index `eta = n_transmitted / n_incident`
 /// (complex for conductors), in the BSDF bases.
 pub(crate) fn reflection(eta: num_complex::Complex64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
-    let f = fresnel_amplitudes(wi.dot(m).abs(), eta).reflection_mueller();
+    let f = fresnel_amplitudes(wi.dot(m).abs(), eta).reflection_block();
     from_sp_frame(&f, m, wo, wi)
 }
 
-/// Re-expresses a Mueller matrix `f` given in the s/p frame of the plane of
-/// incidence at the (micro)normal `m` (light arriving along `-wi`, leaving along
-/// `wo`; x = s on both sides) in the BSDF bases.
-pub(crate) fn from_sp_frame(f: &Mueller, m: &V3, wo: &V3, wi: &V3) -> Mueller {
+/// Re-expresses a block-diagonal matrix `f` given in the s/p frame of the plane
+/// of incidence at the (micro)normal `m` (light arriving along `-wi`, leaving
+/// along `wo`; x = s on both sides) in the BSDF bases, without forming `f` as 4×4.
+/// Inlined into the BSDFs: as a call, the smooth dielectric scene rendered 3% slower.
+#[inline]
+pub(crate) fn from_sp_frame(f: &BlockDiagonal, m: &V3, wo: &V3, wi: &V3) -> Mueller {
     let k_in = -wi;
     let s = s_axis(m, &k_in);
-    to_bsdf_bases(f, &k_in, &s, wo, &s)
+    let (out, inp) = bsdf_rotations(&k_in, &s, wo, &s);
+    f.rotated(out, inp)
 }
 
 /// Fresnel transmission (energy-flux units, no radiance scaling) at the
 /// (micro)normal `m` of light arriving along `-wi` and leaving along `wo`, for the
 /// real relative index `eta = n_wo_side / n_wi_side`, in the BSDF bases.
 pub(crate) fn transmission(eta: f64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
-    let f = fresnel_amplitudes(wi.dot(m).abs(), eta.into()).transmission_mueller();
+    let f = fresnel_amplitudes(wi.dot(m).abs(), eta.into()).transmission_block();
     from_sp_frame(&f, m, wo, wi)
 }
 

@@ -16,8 +16,8 @@
 
 use crate::conductor::{microfacet_reflection, microfacet_reflection_pdf};
 use crate::geometry::{
-    V3, cosine_hemisphere, cosine_hemisphere_pdf, reflect, reflect_z, reflection, s_axis,
-    to_bsdf_bases,
+    V3, cosine_hemisphere, cosine_hemisphere_pdf, rank_one_to_bsdf_bases, reflect, reflect_z,
+    reflection, s_axis,
 };
 use crate::microfacet::Ggx;
 use crate::{BsdfSample, Model, Polarization};
@@ -44,16 +44,18 @@ impl Plastic {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Mueller::zeros();
         }
-        let t_in = fresnel_amplitudes(wi.z, self.eta.into()).transmission_mueller();
+        let t_in = fresnel_amplitudes(wi.z, self.eta.into()).transmitted_unpolarized();
         // The internal direction that refracts out along wo.
         let cos_inside = (1.0 - (1.0 - wo.z * wo.z) / (self.eta * self.eta))
             .max(0.0)
             .sqrt();
-        let t_out = fresnel_amplitudes(cos_inside, (1.0 / self.eta).into()).transmission_mueller();
-        let m = t_out.column(0) * t_in.row(0) * (self.albedo * wi.z * FRAC_1_PI);
+        let t_out =
+            fresnel_amplitudes(cos_inside, (1.0 / self.eta).into()).transmitted_unpolarized();
+        // D = diag(1, 0, 0, 0) keeps column 0 of T_out and row 0 of T_in: rank one.
         let k_in = -wi;
-        to_bsdf_bases(
-            &m,
+        rank_one_to_bsdf_bases(
+            &t_out,
+            &(t_in * (self.albedo * wi.z * FRAC_1_PI)),
             &k_in,
             &s_axis(&V3::z(), &k_in),
             wo,

@@ -61,6 +61,27 @@ impl BlockDiagonal {
         })
     }
 
+    /// `rotator(θo) · B · rotator(θi)` for `out = (cos 2θo, sin 2θo)` and
+    /// `inp = (cos 2θi, sin 2θi)`: the element re-expressed in other bases (a Fresnel
+    /// matrix leaving its s/p frame), written out. The same products as
+    /// [`crate::frame::rotate_rows`] then [`crate::frame::rotate_columns`] on
+    /// [`Self::to_mueller`] minus those with its zeros: 20 multiplications instead of 32.
+    #[inline]
+    pub fn rotated(&self, (co, so): (f64, f64), (ci, si): (f64, f64)) -> Mueller {
+        let (u, l) = (&self.upper, &self.lower);
+        // Rows 1 and 2 after the output rotation: (co u21, co u22, so l11, so l12)
+        // and (−so u21, −so u22, co l11, co l12); then columns 1 and 2 mix.
+        let (r1, r2) = ((co * u.m22, so * l.m11), (-(so * u.m22), co * l.m11));
+        #[rustfmt::skip]
+        let m = Mueller::new(
+            u.m11, ci * u.m12, si * u.m12, 0.0,
+            co * u.m21, ci * r1.0 - si * r1.1, si * r1.0 + ci * r1.1, so * l.m12,
+            -(so * u.m21), ci * r2.0 - si * r2.1, si * r2.0 + ci * r2.1, co * l.m12,
+            0.0, -(si * l.m21), ci * l.m21, l.m22,
+        );
+        m
+    }
+
     /// The full 4×4 matrix.
     #[inline]
     pub fn to_mueller(&self) -> Mueller {

@@ -3,6 +3,7 @@
 //! basis for a given propagation direction `k`, with `y = k × x`.
 
 use crate::mueller::{Mueller, rotator_cos_sin};
+use crate::stokes::Stokes;
 use nalgebra::Vector3;
 
 /// A canonical x axis perpendicular to the propagation direction `k` (unit),
@@ -48,6 +49,13 @@ pub fn rotate_stokes_basis(
 ) -> Mueller {
     let (cos2, sin2) = double_angle(k, current, target);
     rotator_cos_sin(cos2, sin2)
+}
+
+/// `rotator(θ) · s` for `(cos 2θ, sin 2θ)`: a Stokes vector (or the transpose of a
+/// Mueller row, with `−θ`) re-expressed in a rotated basis; only `S1` and `S2` mix.
+#[inline]
+pub fn rotate_stokes(s: &Stokes, (cos2, sin2): (f64, f64)) -> Stokes {
+    Stokes::new(s.x, cos2 * s.y + sin2 * s.z, cos2 * s.z - sin2 * s.y, s.w)
 }
 
 /// `rotator(θ) · m` for `(cos 2θ, sin 2θ)`: only rows 1 and 2 mix.
@@ -161,6 +169,9 @@ mod tests {
             let theta = basis_angle(&k, &x, &target);
             let expected = rotator(theta);
             assert!((rotate_stokes_basis(&k, &x, &target) - expected).amax() < 1e-14);
+            let s = Stokes::new(1.0, 0.3, -0.4, 0.2);
+            let rot = double_angle(&k, &x, &target);
+            assert!((rotate_stokes(&s, rot) - expected * s).amax() < 1e-14);
             let m = Mueller::from_fn(|r, c| (r * 4 + c) as f64 * 0.1 - 0.7);
             let k2 = dir(1.0, 0.5 * i as f64);
             let x2 = stokes_basis(&k2);

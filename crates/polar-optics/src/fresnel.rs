@@ -9,6 +9,7 @@
 
 use crate::block::BlockDiagonal;
 use crate::mueller::Mueller;
+use crate::stokes::Stokes;
 use num_complex::Complex64;
 
 /// Complex Fresnel amplitudes at one angle of incidence.
@@ -201,6 +202,15 @@ impl FresnelAmplitudes {
         self.transmission_block().to_mueller()
     }
 
+    /// First column of [`Self::transmission_mueller`], unpolarized unit light
+    /// transmitted: `((T_s + T_p)/2, (T_s − T_p)/2, 0, 0)`. It is also the first row
+    /// (the matrix is symmetric), so it is all a depolarizing lobe between two
+    /// refractions needs, without the `S2, S3` block.
+    pub fn transmitted_unpolarized(&self) -> Stokes {
+        let (t_s, t_p) = self.transmittance();
+        Stokes::new(0.5 * (t_s + t_p), 0.5 * (t_s - t_p), 0.0, 0.0)
+    }
+
     /// [`Self::transmission_mueller`] in block-diagonal form, for the fast path.
     pub fn transmission_block(&self) -> BlockDiagonal {
         let f = self.flux_factor().sqrt();
@@ -222,6 +232,20 @@ pub fn transmission_mueller(cos_i: f64, eta: Complex64) -> Mueller {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn transmitted_unpolarized_is_the_first_column_and_row() {
+        // Two roundings apart (|t √f|² against f |t|²): 1e-15.
+        for (cos_i, eta) in [(0.9, 1.5), (0.3, 1.5), (0.7, 1.0 / 1.5), (0.05, 2.4)] {
+            let f = fresnel_amplitudes(cos_i, Complex64::new(eta, 0.0));
+            let (m, s) = (f.transmission_mueller(), f.transmitted_unpolarized());
+            assert!((m.column(0) - s).amax() < 1e-15, "cos {cos_i}, eta {eta}");
+            assert!(
+                (m.row(0).transpose() - s).amax() < 1e-15,
+                "cos {cos_i}, eta {eta}"
+            );
+        }
+    }
 
     #[test]
     fn flux_transmission_is_the_same_from_both_sides() {

@@ -32,7 +32,7 @@ pub mod validity;
 pub use block::BlockDiagonal;
 pub use decompose::{LuChipman, lu_chipman};
 pub use error::OpticsError;
-pub use frame::{rotate_mueller_basis, rotate_stokes_basis, stokes_basis};
+pub use frame::{rotate_mueller_basis, rotate_stokes, rotate_stokes_basis, stokes_basis};
 pub use fresnel::{FresnelAmplitudes, fresnel_amplitudes};
 pub use mueller::{LinearMueller, Mueller};
 pub use scatter::PhaseFunction;

@@ -214,3 +214,18 @@ fn block_diagonal_fast_path_equals_full_products() {
     assert!(BlockDiagonal::from_mueller(&depolarizer(0.5, 0.2).unwrap(), 0.0).is_some());
     assert!(BlockDiagonal::from_mueller(&linear_polarizer(0.3), 1e-12).is_none());
 }
+
+#[test]
+fn rotated_block_equals_rotated_rows_and_columns() {
+    use polar_optics::frame::{rotate_columns, rotate_rows};
+    // A conductor's reflection (every block entry non-zero) between two rotations,
+    // one of them past 90° (negative cos 2θ); the written-out form makes the same
+    // products minus those with zeros, so the results are equal, not just close.
+    let b = fresnel_amplitudes(0.6, Complex64::new(0.2, 3.3)).reflection_block();
+    for (out, inp) in [(0.4_f64, -1.1_f64), (2.0, 0.3), (0.0, 0.0)] {
+        let (out, inp) = ((2.0 * out).sin_cos(), (2.0 * inp).sin_cos());
+        let (out, inp) = ((out.1, out.0), (inp.1, inp.0));
+        let expected = rotate_columns(&rotate_rows(&b.to_mueller(), out), inp);
+        assert_eq!((b.rotated(out, inp) - expected).amax(), 0.0);
+    }
+}

@@ -22,7 +22,7 @@ use crate::tracking::Flight;
 use crate::transport::Transport;
 use crate::world::World;
 use polar_bsdf::{Bsdf, Polarization};
-use polar_optics::frame::{double_angle, rotate_rows};
+use polar_optics::frame::double_angle;
 use polar_optics::scatter::PhaseFunction;
 use polar_optics::{Mueller, Stokes, rotate_stokes_basis, stokes_basis};
 
@@ -248,14 +248,15 @@ fn next_event<R: Transport>(
         } else {
             power_heuristic(ls.pdf, pdf)
         };
-        let le = into_frame(&ls.stokes, &-ls.wi, &in_x);
-        add::<R>(sum, &throughput.then(&to_path(&f)), &le, tr * w / ls.pdf);
+        let le = R::from_stokes(&into_frame(&ls.stokes, &-ls.wi, &in_x));
+        // T · (F · le): two matrix–vector products instead of a matrix product.
+        add(sum, throughput, &to_path(&f).apply(&le), tr * w / ls.pdf);
     }
 }
 
 /// `sum += t · le · w`.
-fn add<R: Transport>(sum: &mut Stokes, t: &R, le: &Stokes, w: f64) {
-    *sum += R::to_stokes(&t.apply(&R::from_stokes(le))) * w;
+fn add<R: Transport>(sum: &mut Stokes, t: &R, le: &R::Stokes, w: f64) {
+    *sum += R::to_stokes(&t.apply(le)) * w;
 }
 
 /// One path sample along the primary direction `d0`: the Stokes vector arriving
@@ -294,7 +295,8 @@ pub(crate) fn radiance<R: Transport>(
                                 power_heuristic(*pdf, world.environment_pdf(n.as_ref(), &d))
                             }
                         };
-                        add(&mut sum, &throughput, &into_frame(&le, &-d, &path_x), w);
+                        let le = R::from_stokes(&into_frame(&le, &-d, &path_x));
+                        add(&mut sum, &throughput, &le, w);
                     }
                     break;
                 };
@@ -305,7 +307,8 @@ pub(crate) fn radiance<R: Transport>(
                             power_heuristic(*pdf, world.area_pdf(&hit, p))
                         }
                     };
-                    add(&mut sum, &throughput, &into_frame(&le, &-d, &path_x), w);
+                    let le = R::from_stokes(&into_frame(&le, &-d, &path_x));
+                    add(&mut sum, &throughput, &le, w);
                 }
                 let shape = &world.scene.shapes[hit.shape];
                 let Some(material) = shape.material.map(|m| &world.scene.materials[m].1) else {
@@ -326,13 +329,14 @@ pub(crate) fn radiance<R: Transport>(
         if depth == settings.max_depth {
             break;
         }
-        // The one rotation of this vertex: its output basis into the path frame.
-        let out_rotation =
-            (R::MODEL != Polarization::None).then(|| double_angle(&-d, &vertex.out_x(), &path_x));
-        let to_path = |m: &Mueller| match out_rotation {
-            Some(r) => R::from_mueller(&rotate_rows(m, r)),
-            None => R::from_mueller(m),
+        // The one rotation of this vertex: its output basis into the path frame
+        // (none for scalar transport, which keeps only the rotation-invariant M00).
+        let out_rotation = if R::MODEL == Polarization::None {
+            (1.0, 0.0)
+        } else {
+            double_angle(&-d, &vertex.out_x(), &path_x)
         };
+        let to_path = |m: &Mueller| R::from_rotated(m, out_rotation);
         next_event(world, &vertex, &throughput, &to_path, sampler, &mut sum);
 
         // Continue the path by sampling the BSDF or the phase function.

@@ -9,6 +9,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 use polar_bsdf::Polarization;
+use polar_optics::frame::rotate_rows;
 use polar_optics::{Mueller, Stokes};
 
 /// A path throughput representation: a (reduced) Mueller matrix.
@@ -21,6 +22,10 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn identity() -> Self;
     /// The reduction of a full Mueller matrix.
     fn from_mueller(m: &Mueller) -> Self;
+    /// The reduction of `rotator(θ) · m` for `rot = (cos 2θ, sin 2θ)` (an output
+    /// basis change), touching only the entries the model keeps: the rotation
+    /// mixes rows 1 and 2, which `Scalar` drops and `Linear` keeps 3 columns of.
+    fn from_rotated(m: &Mueller, rot: (f64, f64)) -> Self;
     /// The reduction of a Stokes vector.
     fn from_stokes(s: &Stokes) -> Self::Stokes;
     /// Expands back to a full Stokes vector (zeros for dropped components).
@@ -56,6 +61,10 @@ impl Transport for Scalar {
     fn from_mueller(m: &Mueller) -> Self {
         Scalar(m[(0, 0)])
     }
+    /// `M00` is invariant under basis changes.
+    fn from_rotated(m: &Mueller, _rot: (f64, f64)) -> Self {
+        Self::from_mueller(m)
+    }
     fn from_stokes(s: &Stokes) -> f64 {
         s[0]
     }
@@ -85,6 +94,14 @@ impl Transport for Linear {
     fn from_mueller(m: &Mueller) -> Self {
         Linear(m.fixed_view::<3, 3>(0, 0).into_owned())
     }
+    /// The same arithmetic as [`rotate_rows`] on the 3×3 block only (6 of its 8 pairs).
+    fn from_rotated(m: &Mueller, (cos2, sin2): (f64, f64)) -> Self {
+        Linear(Matrix3::from_fn(|i, j| match i {
+            1 => cos2 * m[(1, j)] + sin2 * m[(2, j)],
+            2 => cos2 * m[(2, j)] - sin2 * m[(1, j)],
+            _ => m[(0, j)],
+        }))
+    }
     fn from_stokes(s: &Stokes) -> Vector3<f64> {
         s.fixed_rows::<3>(0).into_owned()
     }
@@ -113,6 +130,9 @@ impl Transport for Full {
     }
     fn from_mueller(m: &Mueller) -> Self {
         Full(*m)
+    }
+    fn from_rotated(m: &Mueller, rot: (f64, f64)) -> Self {
+        Full(rotate_rows(m, rot))
     }
     fn from_stokes(s: &Stokes) -> Stokes {
         *s
