@@ -9,6 +9,7 @@ mod common;
 
 use common::*;
 use polar_bsdf::Bsdf;
+use polar_testkit::{chi2_critical, pearson};
 use std::f64::consts::PI;
 
 const THETA_BINS: usize = 36;
@@ -16,9 +17,6 @@ const PHI_BINS: usize = 40;
 /// Midpoint sub-samples per bin side when integrating the pdf over a bin.
 const SUB: usize = 8;
 const SAMPLES: usize = 200_000;
-/// Significance level of the chi-square test: a correct sampler fails it with
-/// probability 1e-3 per case (and the seeds are fixed, so it never flakes).
-const Z_ALPHA: f64 = 3.090_232; // standard normal quantile at 1 - 1e-3
 
 fn bin_of(w: &V3) -> usize {
     let t = ((w.z.clamp(-1.0, 1.0).acos() / PI * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
@@ -44,34 +42,6 @@ fn expected_mass(bsdf: &Bsdf, wo: &V3) -> Vec<f64> {
         }
     }
     mass
-}
-
-/// Wilson–Hilferty approximation of the chi-square quantile at `1 − α` for `dof`
-/// degrees of freedom (relative error well below 1% for dof > 10).
-fn chi2_quantile(dof: f64) -> f64 {
-    let a = 2.0 / (9.0 * dof);
-    dof * (1.0 - a + Z_ALPHA * a.sqrt()).powi(3)
-}
-
-/// Pearson statistic over bins pooled so that every cell expects at least 5
-/// samples (cells expecting less are merged into one), and its dof.
-fn pearson(observed: &[f64], expected: &[f64]) -> (f64, f64) {
-    let (mut stat, mut cells) = (0.0, 0usize);
-    let (mut pool_o, mut pool_e) = (0.0, 0.0);
-    for (o, e) in observed.iter().zip(expected) {
-        if *e < 5.0 {
-            pool_o += o;
-            pool_e += e;
-        } else {
-            stat += (o - e).powi(2) / e;
-            cells += 1;
-        }
-    }
-    if pool_e > 0.0 {
-        stat += (pool_o - pool_e).powi(2) / pool_e.max(1.0);
-        cells += 1;
-    }
-    (stat, cells.saturating_sub(1) as f64)
 }
 
 /// The three bins contributing most to the statistic, for failure messages.
@@ -129,7 +99,7 @@ fn chi_square(case: &str) {
                 "{name} wo={wo:?}: {n_obs} samples, pdf integrates to {n_exp}"
             );
             let (stat, dof) = pearson(&observed, &expected);
-            let critical = chi2_quantile(dof);
+            let critical = chi2_critical(dof);
             assert!(
                 stat < critical,
                 "{name} wo={wo:?}: chi2 {stat:.1} >= {critical:.1} (dof {dof}); worst bins {}",

@@ -10,6 +10,7 @@ use polar_optics::scatter::{MieTable, PhaseFunction};
 use polar_optics::stokes::{aolp, dolp, linear, unpolarized};
 use polar_optics::validity::is_realizable;
 use polar_optics::{Mueller, OpticsError, Stokes, stokes_basis};
+use polar_testkit::{chi2_critical, pearson};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -153,28 +154,6 @@ fn sampling_inverts_the_closed_form_cdf() {
 const T_BINS: usize = 60;
 const PHI_BINS: usize = 12;
 const SAMPLES: usize = 200_000;
-/// Standard normal quantile at 1 − 1e-3 (the chi-square test's level; seeds are fixed).
-const Z_ALPHA: f64 = 3.090_232;
-
-/// Pearson statistic and its dof over cells expecting ≥ 5 samples (the rest pooled).
-fn pearson(observed: &[f64], expected: &[f64]) -> (f64, f64) {
-    let (mut stat, mut cells, mut po, mut pe) = (0.0, 0usize, 0.0, 0.0);
-    for (o, e) in observed.iter().zip(expected) {
-        if *e < 5.0 {
-            po += o;
-            pe += e;
-        } else {
-            stat += (o - e).powi(2) / e;
-            cells += 1;
-        }
-    }
-    if pe > 0.0 {
-        stat += (po - pe).powi(2) / pe.max(1.0);
-        cells += 1;
-    }
-    (stat, cells.saturating_sub(1) as f64)
-}
-
 /// Chi-square test of `sample` against `pdf` over (t, φ) bins, φ measured about `k_in`
 /// from `stokes_basis(k_in)`; Wilson–Hilferty quantile at 1 − 1e-3.
 #[test]
@@ -203,8 +182,7 @@ fn chi_square_sampling_against_pdf() {
                 })
                 .collect();
             let (stat, dof) = pearson(&observed, &expected);
-            let a = 2.0 / (9.0 * dof);
-            let critical = dof * (1.0 - a + Z_ALPHA * a.sqrt()).powi(3);
+            let critical = chi2_critical(dof);
             assert!(
                 stat < critical,
                 "{name} k_in {k_in:?}: chi2 {stat:.1} >= {critical:.1} (dof {dof})"
