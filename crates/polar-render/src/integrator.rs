@@ -87,6 +87,17 @@ enum Bounce {
     Smooth { pdf: f64, p: Vec3, n: Option<Vec3> },
 }
 
+impl Bounce {
+    /// MIS weight of emission reached by this bounce against light sampling, whose
+    /// density `light_pdf(p, n)` from the bounce's point is asked only after a smooth bounce.
+    fn mis_weight(&self, light_pdf: impl FnOnce(&Vec3, Option<&Vec3>) -> f64) -> f64 {
+        match self {
+            Bounce::Specular => 1.0,
+            Bounce::Smooth { pdf, p, n } => power_heuristic(*pdf, light_pdf(p, n.as_ref())),
+        }
+    }
+}
+
 /// A scattering vertex: a surface point with its BSDF (in the shading frame), or
 /// a point in the medium with its phase function. Directions `wi` are world
 /// vectors toward where the light comes from.
@@ -289,24 +300,14 @@ pub(crate) fn radiance<R: Transport>(
                 throughput = throughput.scaled(weight);
                 let Some(hit) = hit else {
                     if let Some(le) = world.environment(&-d) {
-                        let w = match &bounce {
-                            Bounce::Specular => 1.0,
-                            Bounce::Smooth { pdf, n, .. } => {
-                                power_heuristic(*pdf, world.environment_pdf(n.as_ref(), &d))
-                            }
-                        };
+                        let w = bounce.mis_weight(|_, n| world.environment_pdf(n, &d));
                         let le = R::from_stokes(&into_frame(&le, &-d, &path_x));
                         add(&mut sum, &throughput, &le, w);
                     }
                     break;
                 };
                 if let Some(le) = world.emitted(&hit, &d) {
-                    let w = match &bounce {
-                        Bounce::Specular => 1.0,
-                        Bounce::Smooth { pdf, p, .. } => {
-                            power_heuristic(*pdf, world.area_pdf(&hit, p))
-                        }
-                    };
+                    let w = bounce.mis_weight(|p, _| world.area_pdf(&hit, p));
                     let le = R::from_stokes(&into_frame(&le, &-d, &path_x));
                     add(&mut sum, &throughput, &le, w);
                 }
