@@ -1,26 +1,38 @@
 #!/usr/bin/env python3
 """Time-to-equal-error of our renderer against Mitsuba 3 (llvm_ad_mono_polarized),
-both on the same number of threads (default 2), on the cross-check scenes.
+both on the same number of threads (default 2), on the cross-check scenes,
+each renderer with an independent and a low-discrepancy sampler.
 
-For each scene and several spp values, both renderers are timed and their
-error measured against a converged Mitsuba reference:
+Curves: for each scene, renderer and sampler, the render time and two errors
+at several spp against a converged reference (BENCH_REFERENCE: the mean of
+two renders with independent seeds, R1 and R2, over the object pixels):
 
-    error = S0 relative RMSE over the object pixels (as in crosscheck.py),
+    S0 error  = RMS(S0 - S0_ref) / mean(S0_ref)
+    pol error = sqrt(mean((S1 - S1_ref)^2 + (S2 - S2_ref)^2)) / mean(S0_ref)
 
-with the reference's own noise removed: the reference is the mean R of two
-independent renders R1, R2, and E|X - T|^2 = E|X - R|^2 - E|R1 - R2|^2 / 4
-(T the truth, X independent of R). Monte Carlo error falls as t^-1/2, so each
-renderer's points are fitted with error = c / sqrt(t) and the time ratio at
-equal error is (c_mitsuba / c_ours)^2 (> 1: ours is faster).
+each with the reference's own noise removed from the mean square
+(E|X - T|^2 = E|X - R|^2 - E|R1 - R2|^2 / 4, T the truth, X independent of R).
 
-Timings: Mitsuba is timed warm (scene loaded, kernel compiled by a 1-spp
-render first: only mi.render); ours is the renderer's own render time from
-meta.json "seconds" when it writes it, else the wall time of the process.
+Time-to-equal-error: for each curve, log(time) is interpolated piecewise
+linearly in log(error) between the measured points (no assumed convergence
+rate: low-discrepancy samplers converge faster than t^-1/2), and the time
+ratio Mitsuba / ours (> 1: ours is faster) is read at the errors Mitsuba
+reaches at 64 and 256 spp, where those lie inside our measured range. Two
+pairs: Mitsuba independent / ours independent (also with the old fit
+error = c / sqrt(t), ratio (c_mitsuba / c_ours)^2, for continuity) and
+Mitsuba's low-discrepancy sampler (MITSUBA_LD) / ours `sobol`.
+
+Timings: Mitsuba is timed warm: at each spp one untimed render first (it
+compiles the kernel, which for the low-discrepancy samplers depends on spp),
+then one timed render (mi.render only); both renders' errors are averaged.
+Ours: the renderer's own render time (meta.json "seconds").
 
     tools/.venv/bin/python tools/mitsuba/bench.py OUT [--refs DIR] [--threads 2]
-        [--spp 16,64,256,1024] [--scenes a,b] [--ours-exe PATH] [--ours-only-if-available]
+        [--spp 16,64,256,1024] [--scenes a,b] [--mitsuba-samplers a,b|all]
+        [--mitsuba-only] [--ours-exe PATH] [--ours-only-if-available]
 
-Writes OUT/bench.json and OUT/bench.png (error vs time, both renderers).
+Writes OUT/bench.json, OUT/bench.png (error vs time, S0 and polarization)
+and prints the tables in markdown.
 """
 
 import argparse
@@ -36,75 +48,263 @@ import ours  # noqa: E402
 import render_refs  # noqa: E402
 import scenes  # noqa: E402
 
+# Mitsuba's low-discrepancy anchor: the sampler that converged furthest in
+# equal time on 4 of the 5 scenes among stratified, multijitter, orthogonal
+# and ldsampler, and within 20% of the best on the fifth (pplastic, where
+# orthogonal overtakes it beyond ~1 s); measured with `--mitsuba-samplers all
+# --mitsuba-only`, README.md "Mitsuba's sampler".
+MITSUBA_LD = "multijitter"
+# Our samplers (render_scene --sampler); without the flag, the scene file's.
+OURS_SAMPLERS = ["independent", "sobol"]
+# Reference per scene: (sampler, spp per pass, passes), the float64 mean of
+# the passes, twice (seeds 0 and 1). Passes of at most 1024 spp: one Mitsuba
+# pass of many samples drifts in float32 (README.md, "Benchmark references").
+# `haze` keeps the cross-check's references (REFERENCE_SPP, independent).
+BENCH_REFERENCE = {
+    "conductor": ("multijitter", 256, 32),
+    "roughconductor": ("multijitter", 1024, 16),
+    "pplastic": ("multijitter", 1024, 16),
+    "dielectric": ("multijitter", 1024, 16),
+    "haze": ("independent", scenes.REFERENCE_SPP["haze"], 1),
+}
+METRICS = ("s0", "pol")
+LEVEL_SPP = (64, 256)  # the comparison errors: Mitsuba's at these spp
+SEED = 1_000_000  # Mitsuba's bench seeds start here, clear of the references' 0..2 * passes
+
 
 def parse_args():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out", type=Path, help="output dir: bench.json, bench.png, our renders")
-    ap.add_argument("--refs", type=Path, default=None, help="Mitsuba reference cache (default: OUT/refs)")
+    ap.add_argument("--refs", type=Path, default=None,
+                    help="reference cache (default: OUT/refs); bench references go to REFS/bench")
     ap.add_argument("--threads", type=int, default=2, help="threads for both renderers (default 2)")
     ap.add_argument("--spp", type=lambda t: [int(v) for v in t.split(",")], default=[16, 64, 256, 1024],
-                    help="comma-separated spp values for both renderers")
-    ap.add_argument("--ref-spp", type=int, default=None, help=f"reference spp (default per scene: {scenes.REFERENCE_SPP})")
+                    help="comma-separated spp values for both renderers (include 64 and 256: the comparison levels)")
     ap.add_argument("--scenes", type=render_refs.parse_scene_list, default=scenes.SCENES)
+    ap.add_argument("--mitsuba-samplers", type=parse_samplers, default=None,
+                    help=f"Mitsuba samplers to time (default: independent,{MITSUBA_LD}; all: every one)")
+    ap.add_argument("--mitsuba-only", action="store_true", help="do not run our renderer (sampler study)")
     ap.add_argument("--ours-exe", type=Path, default=None, help="our render_scene executable (default: cargo build)")
     ap.add_argument("--ours-only-if-available", action="store_true",
                     help="when our renderer is not there yet, bench Mitsuba alone, say so and exit 0")
     return ap.parse_args()
 
 
-class Reference:
-    """Two independent converged Mitsuba renders of one scene."""
+def parse_samplers(text):
+    """Comma-separated Mitsuba sampler names, or `all`."""
+    names = scenes.SAMPLERS if text == "all" else [n for n in text.split(",") if n]
+    unknown = sorted(set(names) - set(scenes.SAMPLERS))
+    if unknown:
+        raise argparse.ArgumentTypeError(f"unknown samplers {unknown}; known: {scenes.SAMPLERS}")
+    return names
 
-    def __init__(self, mi, refs, name, spp):
-        r1, r2 = (scenes.read_stokes_exr(mi, render_refs.ensure_reference(mi, refs / f"seed{s}", name, spp, s))
-                  for s in (0, 1))
+
+class Reference:
+    """The mean of two independent converged Mitsuba renders of one scene."""
+
+    def __init__(self, mi, refs, name):
+        sampler, spp, passes = BENCH_REFERENCE[name]
+        shared = (sampler, spp, passes) == ("independent", scenes.REFERENCE_SPP[name], 1)
+        root = refs if shared else refs / "bench"  # the cross-check's cache, or the bench's own
+        r1, r2 = (scenes.read_stokes_exr(mi, render_refs.ensure_reference(
+            mi, root / f"seed{s}", name, spp, s, sampler=sampler, passes=passes)).astype(np.float64) for s in (0, 1))
+        self.spec = f"{sampler}, {passes} x {spp} spp, 2 seeds"
         self.mask = scenes.object_mask(name)
         self.pixels = self.mask.size
-        self.s0 = 0.5 * (r1[..., 0] + r2[..., 0])[self.mask]
-        self.noise_mse = float(np.mean((r1[..., 0] - r2[..., 0])[self.mask] ** 2)) / 4
-        self.stokes = 0.5 * (r1 + r2)
+        self.stokes = 0.5 * (r1 + r2)[self.mask]
+        self.scale = float(self.stokes[:, 0].mean())
+        self.noise = {k: v / 4 for k, v in mean_squares((r1 - r2)[self.mask]).items()}
 
-    def error(self, stokes):
-        """S0 relative RMSE against the truth, reference noise removed (NaN if below it)."""
-        mse = float(np.mean((stokes[..., 0][self.mask] - self.s0) ** 2)) - self.noise_mse
-        return float(np.sqrt(mse) / self.s0.mean()) if mse > 0 else float("nan")
+    def errors(self, renders):
+        """{metric: relative RMSE against the truth} of the renders (their mean
+        square averaged), reference noise removed (NaN if below it)."""
+        ms = [mean_squares(r.astype(np.float64)[self.mask] - self.stokes) for r in renders]
+        excess = {k: np.mean([m[k] for m in ms]) - self.noise[k] for k in METRICS}
+        return {k: float(np.sqrt(v) / self.scale) if v > 0 else float("nan") for k, v in excess.items()}
 
-    def floor(self):
-        """The reference's own relative error: errors near it are not measurable."""
-        return float(np.sqrt(self.noise_mse) / self.s0.mean())
+    def floors(self):
+        """The reference's own relative errors: errors near them are not measurable."""
+        return {k: float(np.sqrt(v) / self.scale) for k, v in self.noise.items()}
 
 
-def bench_mitsuba(mi, name, spp_list, ref):
-    """[(spp, seconds, error)] for Mitsuba, warm."""
-    scene = mi.load_dict(scenes.scene_dict(mi, name, 1), optimize=False)
-    scenes.render_stokes(mi, scene, 1, seed=99)  # compile the kernels
+def mean_squares(diff):
+    """{"s0": mean dS0^2, "pol": mean (dS1^2 + dS2^2)} of (N, 4) Stokes differences."""
+    return {"s0": float(np.mean(diff[:, 0] ** 2)), "pol": float(np.mean(diff[:, 1] ** 2 + diff[:, 2] ** 2))}
+
+
+def row(spp, samples, seconds, errors):
+    return {"spp": spp, "samples": samples, "seconds": seconds, **errors}
+
+
+def bench_mitsuba(mi, name, sampler, spp_list, ref):
+    """Rows of Mitsuba with `sampler`, timed warm (see the module doc)."""
+    scene = mi.load_dict(scenes.scene_dict(mi, name, 1, sampler), optimize=False)
     rows = []
     for i, spp in enumerate(spp_list):
+        warm = scenes.render_stokes(mi, scene, spp, seed=SEED + 2 * i)
         t0 = time.perf_counter()
-        stokes = scenes.render_stokes(mi, scene, spp, seed=100 + i)
-        rows.append((spp, time.perf_counter() - t0, ref.error(stokes)))
+        timed = scenes.render_stokes(mi, scene, spp, seed=SEED + 2 * i + 1)
+        seconds = time.perf_counter() - t0
+        samples = scene.sensors()[0].sampler().sample_count()
+        rows.append(row(spp, samples, seconds, ref.errors([warm, timed])))
     return rows
 
 
-def bench_ours(exe, name, spp_list, ref, out, threads):
-    """[(spp, seconds, error)] for our renderer, and the timing source."""
+def bench_ours(exe, name, sampler, spp_list, ref, out, threads):
+    """Rows of our renderer with `sampler` (None: the scene file's), and the timing source."""
     rows, source = [], None
     for spp in spp_list:
-        stokes, seconds, source = ours.render(exe, name, out / "ours" / f"{name}-{spp}", spp, threads)
-        rows.append((spp, seconds, ref.error(stokes)))
+        where = out / "ours" / f"{name}-{sampler or 'default'}-{spp}"
+        stokes, seconds, source = ours.render(exe, name, where, spp, threads, sampler)
+        rows.append(row(spp, spp, seconds, ref.errors([stokes])))
     return rows, source
 
 
-def fit_c(rows):
+def frontier(rows, metric):
+    """(times, errors) of the points that improve on every faster point,
+    so that error strictly falls with time (noise can break monotonicity)."""
+    pts = sorted((r["seconds"], r[metric]) for r in rows if np.isfinite(r[metric]) and r["seconds"] > 0)
+    t, e = [], []
+    for ti, ei in pts:
+        if not e or ei < e[-1]:
+            t.append(ti)
+            e.append(ei)
+    return np.array(t), np.array(e)
+
+
+def time_at(rows, metric, level):
+    """Time the curve needs to reach error `level`: log(time) interpolated
+    linearly in log(error) between measured points; NaN outside their range."""
+    t, e = frontier(rows, metric)
+    if len(e) == 0 or not e[-1] <= level <= e[0]:
+        return float("nan")
+    return float(np.exp(np.interp(np.log(level), np.log(e[::-1]), np.log(t[::-1]))))
+
+
+def error_at(rows, metric, seconds):
+    """The error the curve reaches in `seconds`, interpolated like time_at; NaN outside its range."""
+    t, e = frontier(rows, metric)
+    if len(t) == 0 or not t[0] <= seconds <= t[-1]:
+        return float("nan")
+    return float(np.exp(np.interp(np.log(seconds), np.log(t), np.log(e))))
+
+
+def fit_c(rows, metric):
     """c of error = c / sqrt(t), least squares in log space over measurable points."""
-    pts = [(t, e) for _, t, e in rows if np.isfinite(e) and t > 0]
+    pts = [(r["seconds"], r[metric]) for r in rows if np.isfinite(r[metric]) and r["seconds"] > 0]
     return float(np.exp(np.mean([np.log(e) + 0.5 * np.log(t) for t, e in pts]))) if pts else float("nan")
 
 
-def print_rows(name, label, rows, pixels):
-    for spp, t, e in rows:
-        rate = spp * pixels / t / 1e6
-        print(f"{name:<16}{label:<10}{spp:>7}{t:>10.3f}{rate:>12.2f}{100 * e:>12.3f}%")
+def compare(curves, mitsuba, ours_key):
+    """Time ratios Mitsuba / ours at Mitsuba's errors at LEVEL_SPP, per metric
+    (NaN where the level is outside either measured range); for two
+    independent samplers also the c / sqrt(t) fit ratio."""
+    m_rows, o_rows = curves[mitsuba], curves[ours_key]
+    out = {"mitsuba": mitsuba, "ours": ours_key}
+    for metric in METRICS:
+        levels = []
+        for spp in LEVEL_SPP:
+            level = next((r[metric] for r in m_rows if r["spp"] == spp), float("nan"))
+            ratio = time_at(m_rows, metric, level) / time_at(o_rows, metric, level) if np.isfinite(level) else np.nan
+            levels.append({"spp": spp, "error": level, "ratio": float(ratio)})
+        out[metric] = levels
+        if mitsuba.endswith("/independent") and ours_key.endswith("/independent"):
+            out[f"fit_{metric}"] = (fit_c(m_rows, metric) / fit_c(o_rows, metric)) ** 2
+    return out
+
+
+def pairs_of(curves):
+    """The compared (Mitsuba, ours) curve pairs of a scene: independent with
+    independent, Mitsuba's low-discrepancy sampler with our sobol (our
+    default sampler stands in for both when render_scene has no --sampler)."""
+    ours_ind = "ours/independent" if "ours/independent" in curves else "ours/default"
+    ours_ld = "ours/sobol" if "ours/sobol" in curves else "ours/default"
+    pairs = [("mitsuba/independent", ours_ind), (f"mitsuba/{MITSUBA_LD}", ours_ld)]
+    return [(m, o) for m, o in pairs if m in curves and o in curves]
+
+
+def sampler_study(curves):
+    """Among Mitsuba's low-discrepancy curves: their errors (S0, pol) at 3
+    render times spread over the upper two thirds (log scale) of the time
+    range all of them measured, and the sampler with the lowest geometric
+    mean of those errors (the one that converges furthest in equal time)."""
+    ld = {k.split("/")[1]: v for k, v in curves.items() if k.startswith("mitsuba/") and k != "mitsuba/independent"}
+    if len(ld) < 2:
+        return None
+    spans = [frontier(rows, m)[0] for rows in ld.values() for m in METRICS]
+    lo, hi = max(t.min() for t in spans), min(t.max() for t in spans)
+    if not lo < hi:
+        return {"times": [], "note": "the time ranges do not overlap"}
+    times = np.geomspace(lo, hi, 4)[1:]
+    errors = {k: {m: [error_at(rows, m, t) for t in times] for m in METRICS} for k, rows in ld.items()}
+    best = min(errors, key=lambda k: np.mean(np.log(errors[k]["s0"] + errors[k]["pol"])))
+    return {"times": times.tolist(), "errors": errors, "best": best}
+
+
+def fmt_ratio(cell):
+    r, e = cell["ratio"], cell["error"]
+    return f"{r:.2f}x @{100 * e:.3g}%" if np.isfinite(r) else (f"out of range @{100 * e:.3g}%" if np.isfinite(e) else "-")
+
+
+def time_exponent(rows):
+    """k of time ~ samples^k, least squares in log space (1: time linear in spp)."""
+    x, y = np.log([r["samples"] for r in rows]), np.log([r["seconds"] for r in rows])
+    return float(np.polyfit(x, y, 1)[0]) if len(rows) > 1 else float("nan")
+
+
+def print_rows(results, pixels):
+    print("\n| scene | renderer | sampler | spp | samples/px | seconds | Msamples/s | S0 error | pol error |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name, res in results.items():
+        for key, rows in res["curves"].items():
+            renderer, sampler = key.split("/")
+            for r in rows:
+                rate = r["samples"] * pixels[name] / r["seconds"] / 1e6
+                print(f"| {name} | {renderer} | {sampler} | {r['spp']} | {r['samples']} | {r['seconds']:.3f} "
+                      f"| {rate:.2f} | {100 * r['s0']:.4f}% | {100 * r['pol']:.4f}% |")
+    print("\nTime ~ samples^k over the spp values (1: linear, warm):")
+    for name, res in results.items():
+        print(f"  {name:<16}" + ", ".join(f"{key} {time_exponent(rows):.2f}" for key, rows in res["curves"].items()))
+
+
+def print_comparisons(results, pixels):
+    hdr = [f"S0 at M's {s}-spp error" for s in LEVEL_SPP] + [f"pol at M's {s}-spp error" for s in LEVEL_SPP]
+    print("\nTime-to-equal-error, Mitsuba time / our time (> 1: ours faster), at the error Mitsuba reaches"
+          " at the given spp, interpolated on both curves; fit: error = c / sqrt(t) (S0, pol).\n")
+    print("| scene | Mitsuba / ours | Msamples/s M / ours | " + " | ".join(hdr) + " | fit c/sqrt(t) |")
+    print("|" + "---|" * (4 + len(hdr)))
+    geo = {}
+    for name, res in results.items():
+        for cmp in res["comparisons"]:
+            m, o = cmp["mitsuba"], cmp["ours"]
+            rates = [max(r["samples"] * pixels[name] / r["seconds"] for r in res["curves"][k]) / 1e6 for k in (m, o)]
+            cells = [fmt_ratio(c) for metric in METRICS for c in cmp[metric]]
+            fit = f"{cmp['fit_s0']:.2f}x, {cmp['fit_pol']:.2f}x" if "fit_s0" in cmp else "-"
+            pair = f"{m.split('/')[1]} / {o.split('/')[1]}"
+            print(f"| {name} | {pair} | {rates[0]:.1f} / {rates[1]:.1f} | " + " | ".join(cells) + f" | {fit} |")
+            kind = pair
+            for i, c in enumerate(c for metric in METRICS for c in cmp[metric]):
+                if np.isfinite(c["ratio"]):
+                    geo.setdefault(kind, {}).setdefault(i, []).append(c["ratio"])
+    for kind, cols in geo.items():
+        cells = [f"{np.exp(np.mean(np.log(cols[i]))):.2f}x ({len(cols[i])})" if i in cols else "-"
+                 for i in range(len(hdr))]
+        print(f"| geometric mean (scenes) | {kind} | | " + " | ".join(cells) + " | |")
+
+
+def print_study(results):
+    for name, res in results.items():
+        st = res.get("sampler_study")
+        if not st:
+            continue
+        if not st["times"]:
+            print(f"\n{name}: Mitsuba samplers not compared: {st['note']}")
+            continue
+        times = " / ".join(f"{t:.3g} s" for t in st["times"])
+        print(f"\n{name}: Mitsuba's S0 and pol errors after {times}; fastest to converge: {st['best']}")
+        for sampler, errs in st["errors"].items():
+            cells = [f"{100 * e:.3g}%" for m in METRICS for e in errs[m]]
+            print(f"| {name} | {sampler} | " + " | ".join(cells) + " |")
 
 
 def plot(path, results):
@@ -113,69 +313,80 @@ def plot(path, results):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(results), figsize=(4.2 * len(results), 4), constrained_layout=True, squeeze=False)
-    for ax, (name, res) in zip(axes[0], results.items()):
-        for label, style in (("mitsuba", "o-"), ("ours", "s-")):
-            rows = res.get(label)
-            if not rows:
-                continue
-            t = np.array([r[1] for r in rows])
-            ax.loglog(t, [r[2] for r in rows], style, label=f"{label} (c={res['c_' + label]:.3g})")
-            tt = np.geomspace(t.min(), t.max(), 20)
-            ax.loglog(tt, res["c_" + label] / np.sqrt(tt), ":", color=ax.lines[-1].get_color())
-        ax.axhline(res["floor"], color="gray", lw=0.8, label="reference noise")
-        ratio = res.get("speedup")
-        ax.set_title(name + (f"  (speed-up {ratio:.2f}x)" if ratio else ""))
-        ax.set_xlabel("render time (s, 2 threads)")
-        ax.set_ylabel("S0 relative RMSE")
-        ax.legend(fontsize=8)
-    fig.savefig(path, dpi=90)
+    colors = {s: f"C{i}" for i, s in enumerate(scenes.SAMPLERS + ["sobol", "default"])}
+    fig, axes = plt.subplots(len(results), 2, figsize=(9, 3.3 * len(results)), constrained_layout=True, squeeze=False)
+    for ax_row, (name, res) in zip(axes, results.items()):
+        for ax, metric in zip(ax_row, METRICS):
+            for key, rows in res["curves"].items():
+                renderer, sampler = key.split("/")
+                pts = [(r["seconds"], r[metric]) for r in rows if np.isfinite(r[metric])]
+                if pts:
+                    ax.loglog(*zip(*pts), "o-" if renderer == "mitsuba" else "s--", color=colors[sampler],
+                              label=f"{renderer} {sampler}", ms=4)
+            ax.axhline(res["floors"][metric], color="gray", lw=0.8, label="reference noise")
+            ax.set_title(f"{name}: {'S0' if metric == 's0' else 'polarization (S1, S2)'}", fontsize=9)
+            ax.set_xlabel("render time (s)")
+            ax.set_ylabel("relative RMSE")
+            ax.legend(fontsize=6)
+    fig.savefig(path, dpi=80)
     plt.close(fig)
+
+
+def our_renderer(args):
+    """(executable or None, our sampler list, why not) for this run."""
+    if args.mitsuba_only:
+        return None, [], "--mitsuba-only"
+    exe = args.ours_exe
+    if exe is None:
+        gaps = ours.missing(args.scenes)
+        if gaps:
+            return None, [], "missing " + ", ".join(gaps)
+        exe = ours.build()
+    if ours.supports_sampler(exe):
+        return exe, OURS_SAMPLERS, None
+    print("NOTE: render_scene has no --sampler flag yet: our renderer runs with its scene files' sampler only "
+          "(curve ours/default, used in both pairs)")
+    return exe, [None], None
 
 
 def main():
     args = parse_args()
-    mi, dr = scenes.setup_mitsuba(args.threads)
+    mi, _ = scenes.setup_mitsuba(args.threads)
     args.out.mkdir(parents=True, exist_ok=True)
     refs = args.refs or args.out / "refs"
-    exe, why = args.ours_exe, None
-    if exe is None:
-        gaps = ours.missing(args.scenes)
-        why = "missing " + ", ".join(gaps) if gaps else None
-        exe = None if gaps else ours.build()
+    exe, our_samplers, why = our_renderer(args)
+    references = {n: Reference(mi, refs, n) for n in args.scenes}
     results = {}
-    references = {n: Reference(mi, refs, n, args.ref_spp or scenes.REFERENCE_SPP[n]) for n in args.scenes}
-    print(f"\n{'scene':<16}{'renderer':<10}{'spp':>7}{'seconds':>10}{'Msamples/s':>12}{'S0 error':>13}")
     for name, ref in references.items():
-        res = {"floor": ref.floor(), "mitsuba": bench_mitsuba(mi, name, args.spp, ref)}
-        print_rows(name, "mitsuba", res["mitsuba"], ref.pixels)
-        if exe is not None:
+        curves = {}
+        for sampler in args.mitsuba_samplers or ["independent", MITSUBA_LD]:
+            curves[f"mitsuba/{sampler}"] = bench_mitsuba(mi, name, sampler, args.spp, ref)
+            print(f"{name}: mitsuba {sampler} done", flush=True)
+        res = {"reference": ref.spec, "floors": ref.floors(), "curves": curves}
+        for sampler in our_samplers:
             try:
-                res["ours"], res["ours_timing"] = bench_ours(exe, name, args.spp, ref, args.out, args.threads)
-                print_rows(name, "ours", res["ours"], ref.pixels)
+                curves[f"ours/{sampler or 'default'}"], res["ours_timing"] = bench_ours(
+                    exe, name, sampler, args.spp, ref, args.out, args.threads)
+                print(f"{name}: ours {sampler or 'default'} done", flush=True)
             except ours.RenderFailed as err:
-                print(f"{name}: OUR RENDERER FAILED, Mitsuba only:\n{err}")
-        for label in ("mitsuba", "ours"):
-            if label in res:
-                res["c_" + label] = fit_c(res[label])
-        if "ours" in res:
-            res["speedup"] = (res["c_mitsuba"] / res["c_ours"]) ** 2
+                print(f"{name}: OUR RENDERER FAILED ({sampler}), left out:\n{err}")
+        res["comparisons"] = [compare(curves, m, o) for m, o in pairs_of(curves)]
+        res["sampler_study"] = sampler_study(curves)
         results[name] = res
-    print(f"\nreference noise floor (S0 rel. error of the reference itself): "
-          + ", ".join(f"{n} {100 * r['floor']:.2f}%" for n, r in results.items()))
+    pixels = {n: r.pixels for n, r in references.items()}
+    print_rows(results, pixels)
+    print("\n| scene | reference (Mitsuba) | its noise, S0 / pol |\n|---|---|---|")
+    for n, r in results.items():
+        print(f"| {n} | {r['reference']} | {100 * r['floors']['s0']:.4f}% / {100 * r['floors']['pol']:.4f}% |")
+    print_study(results)
     if exe is not None:
-        print("\ntime-to-equal-error, Mitsuba time / our time (fit error = c / sqrt(t)):")
-        for n, r in results.items():
-            if "speedup" in r:
-                print(f"  {n:<16}{r['speedup']:6.2f}x   (our timing: {r['ours_timing']})")
-        speedups = [r["speedup"] for r in results.values() if np.isfinite(r.get("speedup", np.nan))]
-        if speedups:
-            print(f"  {'geometric mean':<16}{np.exp(np.mean(np.log(speedups))):6.2f}x")
-    meta = {"threads": args.threads, "spp": args.spp, "mitsuba": render_refs.scenes_version(), "scenes": results}
+        print_comparisons(results, pixels)
+    meta = {"threads": args.threads, "spp": args.spp, "mitsuba": render_refs.scenes_version(),
+            "pixels": pixels, "scenes": results}
     (args.out / "bench.json").write_text(json.dumps(meta, indent=2) + "\n")
     plot(args.out / "bench.png", results)
     print(f"\nwrote {args.out / 'bench.json'} and {args.out / 'bench.png'}")
-    if exe is None:
+    if exe is None and not args.mitsuba_only:
         print(f"\nOUR RENDERER IS NOT AVAILABLE YET: {why}. Only Mitsuba was benchmarked.")
         sys.exit(0 if args.ours_only_if_available else 2)
 

@@ -1,7 +1,7 @@
 """Runs our renderer (the `render_scene` example of polar-render) on a
 cross-check scene, for crosscheck.py and bench.py.
 
-    cargo run --release -p polar-render --example render_scene -- SCENE OUT_DIR [--spp N]
+    cargo run --release -p polar-render --example render_scene -- SCENE OUT_DIR [--spp N] [--sampler S]
 
 writes OUT_DIR/stokes.exr (channels S0..S3) and, when it does, meta.json with
 the render time in "seconds". The example is built once with cargo, then its
@@ -49,8 +49,16 @@ def build():
     raise RuntimeError("cargo built render_scene but reported no executable")
 
 
-def render(exe, name, out_dir, spp=None, threads=None):
-    """Renders scene `name` into out_dir; returns (stokes (H, W, 4), seconds, timing source).
+def supports_sampler(exe):
+    """True when the executable takes `--sampler` (its usage line, printed
+    when run without arguments, names it)."""
+    proc = subprocess.run([str(exe)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return "--sampler" in proc.stdout + proc.stderr
+
+
+def render(exe, name, out_dir, spp=None, threads=None, sampler=None):
+    """Renders scene `name` into out_dir (with `--sampler` when given); returns
+    (stokes (H, W, 4), seconds, timing source).
 
     seconds is the renderer's own "seconds" from meta.json when it writes one
     (render time without start-up), else the wall time of the whole process.
@@ -58,6 +66,7 @@ def render(exe, name, out_dir, spp=None, threads=None):
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     cmd = [str(exe), str(scene_file(name)), str(out_dir)] + (["--spp", str(spp)] if spp else [])
+    cmd += ["--sampler", sampler] if sampler else []
     env = dict(os.environ, **({"RAYON_NUM_THREADS": str(threads)} if threads else {}))
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

@@ -8,6 +8,11 @@ integrator outputs: see README.md) and OUT/<scene>/meta.json.
     tools/.venv/bin/python tools/mitsuba/render_refs.py OUT [--spp N] [--scenes a,b] [--threads 2]
 
 An existing reference with the same spp and seed is reused unless --force.
+
+bench.py also renders references with a low-discrepancy sampler as the mean
+of several passes (ensure_reference's `sampler` and `passes`): the mean is
+taken in float64, because Mitsuba accumulates a pixel's samples in float32
+and a single pass of many samples drifts (README.md, "Benchmark references").
 """
 
 import argparse
@@ -15,6 +20,8 @@ import json
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import scenes  # noqa: E402
@@ -29,13 +36,15 @@ def parse_scene_list(text):
     return names
 
 
-def cached(out_dir, spp, seed):
-    """True when out_dir holds a reference rendered with this spp and seed."""
+def cached(out_dir, spp, seed, sampler="independent", passes=1):
+    """True when out_dir holds a reference rendered with these settings
+    (a meta.json without sampler / passes is an independent single pass)."""
     meta = out_dir / "meta.json"
     if not (meta.is_file() and (out_dir / "stokes.exr").is_file()):
         return False
     m = json.loads(meta.read_text())
-    return m.get("spp") == spp and m.get("seed") == seed and m.get("mitsuba") == scenes_version()
+    return (m.get("spp") == spp and m.get("seed") == seed and m.get("mitsuba") == scenes_version()
+            and m.get("sampler", "independent") == sampler and m.get("passes", 1) == passes)
 
 
 def scenes_version():
@@ -44,21 +53,25 @@ def scenes_version():
     return f"{mitsuba.__version__} {scenes.VARIANT}"
 
 
-def render_reference(mi, name, spp, seed):
-    """Renders scene `name`; returns (stokes (H, W, 4), seconds)."""
-    scene = mi.load_dict(scenes.scene_dict(mi, name, spp), optimize=False)
+def render_reference(mi, name, spp, seed, sampler="independent", passes=1):
+    """Renders scene `name` as the float64 mean of `passes` renders of `spp`
+    samples each (seeds seed * passes + i: references with different seeds
+    are independent); returns (stokes (H, W, 4), seconds)."""
+    scene = mi.load_dict(scenes.scene_dict(mi, name, spp, sampler), optimize=False)
     t0 = time.perf_counter()
-    stokes = scenes.render_stokes(mi, scene, spp, seed)
-    return stokes, time.perf_counter() - t0
+    total = sum(scenes.render_stokes(mi, scene, spp, seed * passes + i).astype(np.float64) for i in range(passes))
+    return total / passes, time.perf_counter() - t0
 
 
-def ensure_reference(mi, root, name, spp, seed=0, force=False, log=print):
-    """Path of the reference stokes.exr of `name`, rendering it if needed."""
+def ensure_reference(mi, root, name, spp, seed=0, force=False, log=print, sampler="independent", passes=1):
+    """Path of the reference stokes.exr of `name`, rendering it if needed
+    (`passes` renders of `spp` each with `sampler`, averaged)."""
     out_dir = Path(root) / name
-    if not force and cached(out_dir, spp, seed):
-        log(f"{name}: cached reference {out_dir / 'stokes.exr'} ({spp} spp)")
+    what = f"{spp} spp" + (f" x {passes} passes, {sampler}" if (sampler, passes) != ("independent", 1) else "")
+    if not force and cached(out_dir, spp, seed, sampler, passes):
+        log(f"{name}: cached reference {out_dir / 'stokes.exr'} ({what})")
         return out_dir / "stokes.exr"
-    stokes, seconds = render_reference(mi, name, spp, seed)
+    stokes, seconds = render_reference(mi, name, spp, seed, sampler, passes)
     scenes.write_stokes_exr(mi, out_dir / "stokes.exr", stokes)
     meta = {
         "scene": name,
@@ -67,10 +80,12 @@ def ensure_reference(mi, root, name, spp, seed=0, force=False, log=print):
         "size": list(scenes.image_size(name)),
         "spp": spp,
         "seed": seed,
+        "sampler": sampler,
+        "passes": passes,
         "seconds": round(seconds, 3),
     }
     (out_dir / "meta.json").write_text(json.dumps(meta, indent=2) + "\n")
-    log(f"{name}: rendered {spp} spp in {seconds:.1f} s -> {out_dir / 'stokes.exr'}")
+    log(f"{name}: rendered {what} in {seconds:.1f} s -> {out_dir / 'stokes.exr'}")
     return out_dir / "stokes.exr"
 
 

@@ -140,8 +140,14 @@ def look_at(mi):
     )
 
 
-def sensor_dict(mi, spp, width=WIDTH, height=HEIGHT):
-    """Perspective sensor with a box filter and an independent sampler."""
+# Mitsuba's samplers (bench.py compares them; the cross-check uses `independent`).
+# `orthogonal` rounds the sample count up to the square of a prime (16 -> 25,
+# 64 -> 121, 256 -> 289, 1024 -> 1369): read the count back, do not assume it.
+SAMPLERS = ["independent", "stratified", "multijitter", "orthogonal", "ldsampler"]
+
+
+def sensor_dict(mi, spp, width=WIDTH, height=HEIGHT, sampler="independent"):
+    """Perspective sensor with a box filter and the given sampler (default independent)."""
     return {
         "type": "perspective",
         "fov": FOV_DEG,
@@ -153,7 +159,7 @@ def sensor_dict(mi, spp, width=WIDTH, height=HEIGHT):
             "height": height,
             "rfilter": {"type": "box"},
         },
-        "sampler": {"type": "independent", "sample_count": spp},
+        "sampler": {"type": sampler, "sample_count": spp},
     }
 
 
@@ -162,7 +168,7 @@ def stokes_integrator(max_depth=MAX_DEPTH, inner="path"):
     return {"type": "stokes", "integrator": {"type": inner, "max_depth": max_depth}}
 
 
-def haze_dict(mi, spp):
+def haze_dict(mi, spp, sampler="independent"):
     """The Mitsuba scene of `haze`: the medium fills a null-BSDF cube (its
     `interior`); the sphere inside declares it as its `exterior` (volpath
     keeps the current medium at a surface that is no medium transition, so
@@ -179,7 +185,7 @@ def haze_dict(mi, spp):
     return {
         "type": "scene",
         "integrator": stokes_integrator(inner="volpath"),
-        "sensor": sensor_dict(mi, spp, *h["size"]),
+        "sensor": sensor_dict(mi, spp, *h["size"], sampler=sampler),
         "haze": medium,
         "box": {
             "type": "cube",
@@ -199,14 +205,14 @@ def haze_dict(mi, spp):
     }
 
 
-def scene_dict(mi, name, spp):
-    """The Mitsuba scene dictionary of cross-check scene `name`."""
+def scene_dict(mi, name, spp, sampler="independent"):
+    """The Mitsuba scene dictionary of cross-check scene `name` (sampler: one of SAMPLERS)."""
     if name == "haze":
-        return haze_dict(mi, spp)
+        return haze_dict(mi, spp, sampler)
     return {
         "type": "scene",
         "integrator": stokes_integrator(),
-        "sensor": sensor_dict(mi, spp),
+        "sensor": sensor_dict(mi, spp, sampler=sampler),
         "sphere": {
             "type": "sphere",
             "center": [0.0, 0.0, 0.0],
