@@ -63,6 +63,9 @@ impl PinholeCamera {
 
     /// The x axis of the conventions' per-pixel Stokes frame for the ray
     /// direction `d`: `x_ref = normalize(d × u)` (then `y_ref = x_ref × d`).
+    /// Never inlined: the integrator asks for it only when needed, and inlined, the
+    /// compiler hoisted its square root and division out of that condition.
+    #[inline(never)]
     pub fn film_frame(&self, d: &Vec3) -> Vec3 {
         d.cross(&self.user_up).normalize()
     }

@@ -53,12 +53,15 @@ impl Frame {
 }
 
 /// Re-expresses Stokes `s` travelling along `k` from the implicit frame
-/// `stokes_basis(k)` into the frame with x axis `x` (nothing to do when unpolarized).
-fn into_frame(s: &Stokes, k: &Vec3, x: &Vec3) -> Stokes {
+/// `stokes_basis(k)` into the frame with x axis `x()` (nothing to do, and `x` not
+/// asked, when unpolarized). Inlined: returned through memory, the vector was
+/// read back before its stores were done (a store-forwarding stall).
+#[inline]
+fn into_frame(s: &Stokes, k: &Vec3, x: impl FnOnce() -> Vec3) -> Stokes {
     if s[1] == 0.0 && s[2] == 0.0 && s[3] == 0.0 {
         *s
     } else {
-        rotate_stokes_basis(k, &stokes_basis(k), x) * s
+        rotate_stokes_basis(k, &stokes_basis(k), &x()) * s
     }
 }
 
@@ -225,7 +228,7 @@ impl Vertex<'_> {
 fn next_event<R: Transport>(
     world: &World,
     vertex: &Vertex,
-    throughput: &R,
+    throughput: Option<&R>,
     to_path: &impl Fn(&Mueller) -> R,
     sampler: &mut Sampler,
     sum: &mut Stokes,
@@ -259,37 +262,39 @@ fn next_event<R: Transport>(
         } else {
             power_heuristic(ls.pdf, pdf)
         };
-        let le = R::from_stokes(&into_frame(&ls.stokes, &-ls.wi, &in_x));
+        let le = R::from_stokes(&into_frame(&ls.stokes, &-ls.wi, || in_x));
         // T · (F · le): two matrix–vector products instead of a matrix product.
         add(sum, throughput, &to_path(&f).apply(&le), tr * w / ls.pdf);
     }
 }
 
-/// `sum += t · le · w`.
-fn add<R: Transport>(sum: &mut Stokes, t: &R, le: &R::Stokes, w: f64) {
-    *sum += R::to_stokes(&t.apply(le)) * w;
+/// `sum += t · le · w`, with `t = None` the identity (exactly: `I · le = le`).
+fn add<R: Transport>(sum: &mut Stokes, t: Option<&R>, le: &R::Stokes, w: f64) {
+    let le = t.map_or(*le, |t| t.apply(le));
+    *sum += R::to_stokes(&le) * w;
 }
 
 /// One path sample along the primary direction `d0`: the Stokes vector arriving
-/// at the camera, in the frame with x axis `x_ref` (the per-pixel camera frame).
-pub(crate) fn radiance<R: Transport>(
-    world: &World,
-    d0: &Vec3,
-    x_ref: &Vec3,
-    sampler: &mut Sampler,
-) -> Stokes {
+/// at the camera, in the per-pixel camera frame (`film_frame(d0)`).
+///
+/// Work skipped without changing a bit of the result: the film frame is only
+/// computed when something polarized or a vertex needs it (a primary ray that
+/// sees an unpolarized environment never does), and the throughput is `None`
+/// while it is the identity (products with it are copies).
+pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sampler) -> Stokes {
     let settings = &world.scene.settings;
     let (mut o, mut d) = (world.camera.position, *d0);
-    let mut throughput = R::identity();
-    let mut path_x = *x_ref;
+    let mut throughput: Option<R> = None;
+    // The path frame's x axis; `None` for the film frame of the primary ray.
+    let mut path_x: Option<Vec3> = None;
+    let path_frame = |x: Option<Vec3>| x.unwrap_or_else(|| world.camera.film_frame(d0));
     let mut sum = Stokes::zeros();
     let mut bounce = Bounce::Specular;
     for depth in 0..=settings.max_depth {
         let hit = world.intersect(&o, &d);
-        let t_hit = hit.as_ref().map_or(f64::INFINITY, |h| (h.p - o).norm());
-        let vertex = match world.flight(&o, &d, t_hit, sampler) {
+        let vertex = match world.flight(&o, &d, hit.as_ref(), sampler) {
             Flight::Scatter { t, weight, medium } => {
-                throughput = throughput.scaled(weight);
+                throughput = Some(throughput.unwrap_or_else(R::identity).scaled(weight));
                 Vertex::Medium {
                     p: o + t * d,
                     phase: &medium.phase,
@@ -297,19 +302,21 @@ pub(crate) fn radiance<R: Transport>(
                 }
             }
             Flight::Pass { weight } => {
-                throughput = throughput.scaled(weight);
+                if weight != 1.0 {
+                    throughput = Some(throughput.unwrap_or_else(R::identity).scaled(weight));
+                }
                 let Some(hit) = hit else {
                     if let Some(le) = world.environment(&-d) {
                         let w = bounce.mis_weight(|_, n| world.environment_pdf(n, &d));
-                        let le = R::from_stokes(&into_frame(&le, &-d, &path_x));
-                        add(&mut sum, &throughput, &le, w);
+                        let le = R::from_stokes(&into_frame(&le, &-d, || path_frame(path_x)));
+                        add(&mut sum, throughput.as_ref(), &le, w);
                     }
                     break;
                 };
                 if let Some(le) = world.emitted(&hit, &d) {
                     let w = bounce.mis_weight(|p, _| world.area_pdf(&hit, p));
-                    let le = R::from_stokes(&into_frame(&le, &-d, &path_x));
-                    add(&mut sum, &throughput, &le, w);
+                    let le = R::from_stokes(&into_frame(&le, &-d, || path_frame(path_x)));
+                    add(&mut sum, throughput.as_ref(), &le, w);
                 }
                 let shape = &world.scene.shapes[hit.shape];
                 let Some(material) = shape.material.map(|m| &world.scene.materials[m].1) else {
@@ -335,17 +342,25 @@ pub(crate) fn radiance<R: Transport>(
         let out_rotation = if R::MODEL == Polarization::None {
             (1.0, 0.0)
         } else {
-            double_angle(&-d, &vertex.out_x(), &path_x)
+            double_angle(&-d, &vertex.out_x(), &path_frame(path_x))
         };
         let to_path = |m: &Mueller| R::from_rotated(m, out_rotation);
-        next_event(world, &vertex, &throughput, &to_path, sampler, &mut sum);
+        next_event(
+            world,
+            &vertex,
+            throughput.as_ref(),
+            &to_path,
+            sampler,
+            &mut sum,
+        );
 
         // Continue the path by sampling the BSDF or the phase function.
         let Some(s) = vertex.sample(sampler.next_3d()) else {
             break;
         };
-        throughput = throughput.then(&to_path(&s.weight));
-        path_x = s.in_x;
+        let weight = to_path(&s.weight);
+        let mut t = throughput.map_or(weight, |t| t.then(&weight));
+        path_x = Some(s.in_x);
         bounce = if s.is_delta {
             Bounce::Specular
         } else {
@@ -356,12 +371,13 @@ pub(crate) fn radiance<R: Transport>(
             }
         };
         if depth >= RR_DEPTH {
-            let q = throughput.m00().clamp(0.0, 0.95);
+            let q = t.m00().clamp(0.0, 0.95);
             if sampler.next_1d() >= q {
                 break;
             }
-            throughput = throughput.scaled(1.0 / q);
+            t = t.scaled(1.0 / q);
         }
+        throughput = Some(t);
         o = vertex.spawn(&s.wi);
         d = s.wi;
     }

@@ -191,7 +191,7 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
                 let mut sampler = streams.sample(u64::from(s));
                 let [jx, jy] = sampler.next_2d();
                 let d = world.camera.direction(x as f64 + jx, y as f64 + jy);
-                sum += radiance::<R>(world, &d, &world.camera.film_frame(&d), &mut sampler);
+                sum += radiance::<R>(world, &d, &mut sampler);
             }
             let mean = sum / f64::from(settings.spp);
             tile.stokes.push([

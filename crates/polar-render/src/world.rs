@@ -155,11 +155,21 @@ impl<'a> World<'a> {
         Some(self.accel.surface(self.scene, hit, o, d))
     }
 
-    /// The first scattering event along `o + t d` before `t_max`, or passing through
-    /// (always `Pass` with weight 1, drawing no random numbers, without a medium).
-    pub fn flight(&self, o: &Vec3, d: &Vec3, t_max: f64, sampler: &mut Sampler) -> Flight<'a> {
+    /// The first scattering event along `o + t d` before the surface `hit` (if any),
+    /// or passing through (always `Pass` with weight 1, drawing no random numbers,
+    /// without a medium: the distance to the hit is only computed with one).
+    pub fn flight(
+        &self,
+        o: &Vec3,
+        d: &Vec3,
+        hit: Option<&SurfaceHit>,
+        sampler: &mut Sampler,
+    ) -> Flight<'a> {
         match &self.scene.medium {
-            Some(m) => tracking::flight(m, o, d, t_max, sampler),
+            Some(m) => {
+                let t_max = hit.map_or(f64::INFINITY, |h| (h.p - o).norm());
+                tracking::flight(m, o, d, t_max, sampler)
+            }
             None => Flight::Pass { weight: 1.0 },
         }
     }
