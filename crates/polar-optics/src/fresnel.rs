@@ -45,6 +45,10 @@ pub struct FresnelAmplitudes {
 /// (`−1` at exactly grazing), `t = 0` (relative error `~1/|η|`, below `f64` precision),
 /// so that `|η²|²` never overflows in the complex divisions. Undefined inputs give
 /// NaN amplitudes: a NaN or infinite `cos_i`, or a NaN component of `eta`.
+///
+/// Inlined across crates (BSDF sampling's hot path): a caller that keeps only
+/// the reflection amplitudes then skips the transmission ones.
+#[inline]
 pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
     let zero = Complex64::new(0.0, 0.0);
     let one = Complex64::new(1.0, 0.0);
@@ -120,6 +124,7 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
 
 /// `1 / z` with one real division (num-complex's division has two); like it,
 /// through `|z|²`, which the `|η| ≤ 1e30` bound keeps finite.
+#[inline]
 fn recip(z: Complex64) -> Complex64 {
     let k = 1.0 / z.norm_sqr();
     Complex64::new(z.re * k, -z.im * k)
@@ -129,6 +134,7 @@ fn recip(z: Complex64) -> Complex64 {
 /// polar form: atan2 and sin_cos): with `m = |z|`, `√z = (√((m+a)/2), sign(b) √((m−a)/2))`
 /// for `z = a + ib`, taking the larger part first and the other as `b / 2t`
 /// (no cancellation). `b = +0` on the negative real axis gives `+i√|a|`.
+#[inline]
 fn principal_sqrt(z: Complex64) -> Complex64 {
     let (a, b) = (z.re, z.im);
     // |z| directly where the squares neither overflow nor lose precision to
@@ -184,6 +190,7 @@ impl FresnelAmplitudes {
     }
 
     /// [`Self::reflection_mueller`] in block-diagonal form, for the fast path.
+    #[inline]
     pub fn reflection_block(&self) -> BlockDiagonal {
         BlockDiagonal::from_diagonal_jones(self.r_s, self.r_p)
     }
@@ -212,6 +219,7 @@ impl FresnelAmplitudes {
     }
 
     /// [`Self::transmission_mueller`] in block-diagonal form, for the fast path.
+    #[inline]
     pub fn transmission_block(&self) -> BlockDiagonal {
         let f = self.flux_factor().sqrt();
         BlockDiagonal::from_diagonal_jones(self.t_s * f, self.t_p * f)
