@@ -17,7 +17,7 @@ Time-to-equal-error: for each curve, log(time) is interpolated piecewise
 linearly in log(error) between the measured points (no assumed convergence
 rate: low-discrepancy samplers converge faster than t^-1/2), and the time
 ratio Mitsuba / ours (> 1: ours is faster) is read at the errors Mitsuba
-reaches at 64 and 256 spp, where those lie inside our measured range. Two
+reaches at 64, 256 and 1024 spp, where those lie inside our measured range. Two
 pairs: Mitsuba independent / ours independent (also with the old fit
 error = c / sqrt(t), ratio (c_mitsuba / c_ours)^2, for continuity) and
 Mitsuba's low-discrepancy sampler (MITSUBA_LD) / ours `sobol`.
@@ -25,7 +25,10 @@ Mitsuba's low-discrepancy sampler (MITSUBA_LD) / ours `sobol`.
 Timings: Mitsuba is timed warm: at each spp one untimed render first (it
 compiles the kernel, which for the low-discrepancy samplers depends on spp),
 then one timed render (mi.render only); both renders' errors are averaged.
-Ours: the renderer's own render time (meta.json "seconds").
+Ours: the renderer's own render time (meta.json "seconds"). CPU time is
+recorded too (process time of Mitsuba's render; our whole process), and the
+ratios are printed for both clocks: wall time is the measure on an idle
+machine, CPU time the one a loaded machine distorts less (README.md).
 
     tools/.venv/bin/python tools/mitsuba/bench.py OUT [--refs DIR] [--threads 2]
         [--spp 16,64,256,1024] [--scenes a,b] [--mitsuba-samplers a,b|all]
@@ -37,6 +40,7 @@ and prints the tables in markdown.
 
 import argparse
 import json
+import resource
 import sys
 import time
 from pathlib import Path
@@ -68,7 +72,8 @@ BENCH_REFERENCE = {
     "haze": ("independent", scenes.REFERENCE_SPP["haze"], 1),
 }
 METRICS = ("s0", "pol")
-LEVEL_SPP = (64, 256)  # the comparison errors: Mitsuba's at these spp
+CLOCKS = ("wall", "cpu")
+LEVEL_SPP = (64, 256, 1024)  # the comparison errors: Mitsuba's at these spp
 SEED = 1_000_000  # Mitsuba's bench seeds start here, clear of the references' 0..2 * passes
 
 
@@ -79,7 +84,7 @@ def parse_args():
                     help="reference cache (default: OUT/refs); bench references go to REFS/bench")
     ap.add_argument("--threads", type=int, default=2, help="threads for both renderers (default 2)")
     ap.add_argument("--spp", type=lambda t: [int(v) for v in t.split(",")], default=[16, 64, 256, 1024],
-                    help="comma-separated spp values for both renderers (include 64 and 256: the comparison levels)")
+                    help="comma-separated spp values for both renderers (include 64, 256, 1024: the comparison levels)")
     ap.add_argument("--scenes", type=render_refs.parse_scene_list, default=scenes.SCENES)
     ap.add_argument("--mitsuba-samplers", type=parse_samplers, default=None,
                     help=f"Mitsuba samplers to time (default: independent,{MITSUBA_LD}; all: every one)")
@@ -132,8 +137,14 @@ def mean_squares(diff):
     return {"s0": float(np.mean(diff[:, 0] ** 2)), "pol": float(np.mean(diff[:, 1] ** 2 + diff[:, 2] ** 2))}
 
 
-def row(spp, samples, seconds, errors):
-    return {"spp": spp, "samples": samples, "seconds": seconds, **errors}
+def row(spp, samples, seconds, cpu_seconds, errors):
+    return {"spp": spp, "samples": samples, "seconds": seconds, "cpu_seconds": cpu_seconds, **errors}
+
+
+def children_cpu():
+    """CPU seconds (user + system) used so far by finished child processes."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def bench_mitsuba(mi, name, sampler, spp_list, ref):
@@ -142,11 +153,11 @@ def bench_mitsuba(mi, name, sampler, spp_list, ref):
     rows = []
     for i, spp in enumerate(spp_list):
         warm = scenes.render_stokes(mi, scene, spp, seed=SEED + 2 * i)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         timed = scenes.render_stokes(mi, scene, spp, seed=SEED + 2 * i + 1)
-        seconds = time.perf_counter() - t0
+        seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
         samples = scene.sensors()[0].sampler().sample_count()
-        rows.append(row(spp, samples, seconds, ref.errors([warm, timed])))
+        rows.append(row(spp, samples, seconds, cpu, ref.errors([warm, timed])))
     return rows
 
 
@@ -155,8 +166,9 @@ def bench_ours(exe, name, sampler, spp_list, ref, out, threads):
     rows, source = [], None
     for spp in spp_list:
         where = out / "ours" / f"{name}-{sampler or 'default'}-{spp}"
+        c0 = children_cpu()
         stokes, seconds, source = ours.render(exe, name, where, spp, threads, sampler)
-        rows.append(row(spp, spp, seconds, ref.errors([stokes])))
+        rows.append(row(spp, spp, seconds, children_cpu() - c0, ref.errors([stokes])))
     return rows, source
 
 
@@ -253,29 +265,30 @@ def time_exponent(rows):
 
 
 def print_rows(results, pixels):
-    print("\n| scene | renderer | sampler | spp | samples/px | seconds | Msamples/s | S0 error | pol error |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("\n| scene | renderer | sampler | spp | samples/px | wall s | CPU s | Msamples/s (wall) | S0 error | pol error |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for name, res in results.items():
         for key, rows in res["curves"].items():
             renderer, sampler = key.split("/")
             for r in rows:
                 rate = r["samples"] * pixels[name] / r["seconds"] / 1e6
                 print(f"| {name} | {renderer} | {sampler} | {r['spp']} | {r['samples']} | {r['seconds']:.3f} "
+                      f"| {r['cpu_seconds']:.3f} "
                       f"| {rate:.2f} | {100 * r['s0']:.4f}% | {100 * r['pol']:.4f}% |")
     print("\nTime ~ samples^k over the spp values (1: linear, warm):")
     for name, res in results.items():
         print(f"  {name:<16}" + ", ".join(f"{key} {time_exponent(rows):.2f}" for key, rows in res["curves"].items()))
 
 
-def print_comparisons(results, pixels):
+def print_comparisons(results, pixels, clock):
     hdr = [f"S0 at M's {s}-spp error" for s in LEVEL_SPP] + [f"pol at M's {s}-spp error" for s in LEVEL_SPP]
-    print("\nTime-to-equal-error, Mitsuba time / our time (> 1: ours faster), at the error Mitsuba reaches"
-          " at the given spp, interpolated on both curves; fit: error = c / sqrt(t) (S0, pol).\n")
-    print("| scene | Mitsuba / ours | Msamples/s M / ours | " + " | ".join(hdr) + " | fit c/sqrt(t) |")
+    print(f"\nTime-to-equal-error, Mitsuba {clock} time / our {clock} time (> 1: ours faster), at the error"
+          " Mitsuba reaches at the given spp, interpolated on both curves; fit: error = c / sqrt(t) (S0, pol).\n")
+    print("| scene | Mitsuba / ours | Msamples/s (wall) M / ours | " + " | ".join(hdr) + " | fit c/sqrt(t) |")
     print("|" + "---|" * (4 + len(hdr)))
     geo = {}
     for name, res in results.items():
-        for cmp in res["comparisons"]:
+        for cmp in res["comparisons"][clock]:
             m, o = cmp["mitsuba"], cmp["ours"]
             rates = [max(r["samples"] * pixels[name] / r["seconds"] for r in res["curves"][k]) / 1e6 for k in (m, o)]
             cells = [fmt_ratio(c) for metric in METRICS for c in cmp[metric]]
@@ -325,7 +338,7 @@ def plot(path, results):
                               label=f"{renderer} {sampler}", ms=4)
             ax.axhline(res["floors"][metric], color="gray", lw=0.8, label="reference noise")
             ax.set_title(f"{name}: {'S0' if metric == 's0' else 'polarization (S1, S2)'}", fontsize=9)
-            ax.set_xlabel("render time (s)")
+            ax.set_xlabel("render time (s, wall)")
             ax.set_ylabel("relative RMSE")
             ax.legend(fontsize=6)
     fig.savefig(path, dpi=80)
@@ -349,6 +362,13 @@ def our_renderer(args):
     return exe, [None], None
 
 
+def on_clock(curves, clock):
+    """The curves with `seconds` = wall time, or CPU time for clock `cpu`."""
+    if clock == "wall":
+        return curves
+    return {k: [dict(r, seconds=r["cpu_seconds"]) for r in rows] for k, rows in curves.items()}
+
+
 def main():
     args = parse_args()
     mi, _ = scenes.setup_mitsuba(args.threads)
@@ -370,7 +390,8 @@ def main():
                 print(f"{name}: ours {sampler or 'default'} done", flush=True)
             except ours.RenderFailed as err:
                 print(f"{name}: OUR RENDERER FAILED ({sampler}), left out:\n{err}")
-        res["comparisons"] = [compare(curves, m, o) for m, o in pairs_of(curves)]
+        res["comparisons"] = {clock: [compare(on_clock(curves, clock), m, o) for m, o in pairs_of(curves)]
+                              for clock in CLOCKS}
         res["sampler_study"] = sampler_study(curves)
         results[name] = res
     pixels = {n: r.pixels for n, r in references.items()}
@@ -380,7 +401,8 @@ def main():
         print(f"| {n} | {r['reference']} | {100 * r['floors']['s0']:.4f}% / {100 * r['floors']['pol']:.4f}% |")
     print_study(results)
     if exe is not None:
-        print_comparisons(results, pixels)
+        for clock in CLOCKS:
+            print_comparisons(results, pixels, clock)
     meta = {"threads": args.threads, "spp": args.spp, "mitsuba": render_refs.scenes_version(),
             "pixels": pixels, "scenes": results}
     (args.out / "bench.json").write_text(json.dumps(meta, indent=2) + "\n")
