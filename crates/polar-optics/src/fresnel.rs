@@ -88,6 +88,40 @@ pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
         };
     }
     let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+    if eta.im == 0.0 && cos_i > 0.0 && eta.re * eta.re > sin2_i {
+        return real_amplitudes(cos_i, eta.re, sin2_i);
+    }
+    complex_amplitudes(cos_i, eta, sin2_i)
+}
+
+/// [`fresnel_amplitudes`] for a real index without total internal reflection, off
+/// grazing (glass below the critical angle): the same formulas in real arithmetic, one
+/// square root and two divisions instead of a complex square root and two complex
+/// reciprocals. Equal to [`complex_amplitudes`] up to rounding (`1/x` rounds once where
+/// the complex reciprocal `x/x²` rounds twice; the square roots agree exactly).
+#[inline]
+fn real_amplitudes(cos_i: f64, eta: f64, sin2_i: f64) -> FresnelAmplitudes {
+    let w = (eta * eta - sin2_i).sqrt();
+    let eta2_ci = eta * eta * cos_i;
+    let (inv_s, inv_p) = (1.0 / (cos_i + w), 1.0 / (eta2_ci + w));
+    let real = |x: f64| Complex64::new(x, 0.0);
+    FresnelAmplitudes {
+        r_s: real((cos_i - w) * inv_s),
+        r_p: real((eta2_ci - w) * inv_p),
+        t_s: real(2.0 * cos_i * inv_s),
+        t_p: real(2.0 * eta * cos_i * inv_p),
+        eta_cos_t: real(w),
+        cos_i,
+    }
+}
+
+/// [`fresnel_amplitudes`] in complex arithmetic (conductors, total internal reflection,
+/// grazing incidence) for `cos_i` in `[0, 1]` and `sin2_i = 1 − cos_i²`.
+#[inline]
+fn complex_amplitudes(cos_i: f64, eta: Complex64, sin2_i: f64) -> FresnelAmplitudes {
+    let zero = Complex64::new(0.0, 0.0);
+    let one = Complex64::new(1.0, 0.0);
+    let ci = Complex64::new(cos_i, 0.0);
     let mut d = eta * eta - sin2_i;
     // Keep the branch cut on the correct side for real negative arguments (TIR).
     if d.im == 0.0 {
@@ -272,6 +306,41 @@ mod tests {
                 assert!((a - b).amax() < 1e-12, "eta {eta}, cos {cos_1}: {a} {b}");
             }
         }
+    }
+
+    #[test]
+    fn real_index_fast_path_matches_the_complex_formulas() {
+        // Glass from outside and inside below the critical angle, near index matching, and
+        // Brewster's angle (r_p = 0, hence an absolute tolerance): 4e-16, about two ulps of
+        // amplitudes of magnitude <= 2 (the complex reciprocal rounds twice, 1/x once).
+        for eta in [1.5_f64, 1.0 / 1.5, 2.4, 1.0001, 0.9999, 1.33] {
+            let brewster = 1.0 / (1.0 + eta * eta).sqrt();
+            for cos_i in [1.0, 0.999, 0.9, brewster, 0.5, 0.2, 0.01, 1e-6] {
+                let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+                if eta * eta <= sin2_i {
+                    continue;
+                }
+                let (r, c) = (
+                    real_amplitudes(cos_i, eta, sin2_i),
+                    complex_amplitudes(cos_i, Complex64::new(eta, 0.0), sin2_i),
+                );
+                for (a, b) in [
+                    (r.r_s, c.r_s),
+                    (r.r_p, c.r_p),
+                    (r.t_s, c.t_s),
+                    (r.t_p, c.t_p),
+                ] {
+                    assert!(
+                        (a - b).norm() <= 2e-16 * 2.0,
+                        "eta {eta}, cos {cos_i}: {a} {b}"
+                    );
+                }
+                assert_eq!(r.eta_cos_t, c.eta_cos_t, "eta {eta}, cos {cos_i}");
+            }
+        }
+        // The dispatch: real index below the critical angle takes the fast path.
+        let f = fresnel_amplitudes(0.5, Complex64::new(1.5, 0.0));
+        assert_eq!(f, real_amplitudes(0.5, 1.5, 0.75));
     }
 
     #[test]
