@@ -110,12 +110,18 @@ impl Primitive {
                 // Stable quadratic for |d| = 1: t = -b ± sqrt(r² - |f - b d|²) with f = o - c, b = f·d.
                 let f = o - center;
                 let b = f.dot(d);
+                let c = f.norm_squared() - radius * radius;
+                // From outside (c > 0) moving away (b > 0) both roots are negative (product
+                // c, sum −2b): no hit at t ≥ 0, known before the square root and division
+                // (rays leaving a convex sphere after reflection, shadow rays from it).
+                if c > 0.0 && b > 0.0 && tmin >= 0.0 {
+                    return None;
+                }
                 let disc = radius * radius - (f - b * d).norm_squared();
                 if disc < 0.0 {
                     return None;
                 }
                 let root = disc.sqrt();
-                let c = f.norm_squared() - radius * radius;
                 let q = -b - root.copysign(b);
                 let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q) };
                 let (t0, t1) = (t0.min(t1), t0.max(t1));
