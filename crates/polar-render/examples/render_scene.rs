@@ -2,9 +2,9 @@
 //! (with a medium also `gt/clear.exr` and `gt/transmission.exr`) and
 //! `meta.json` (with the render time in `seconds`) into OUT_DIR.
 //!
-//! `cargo run --release -p polar-render --example render_scene -- SCENE OUT_DIR [--spp N] [--model none|linear|full]`
+//! `cargo run --release -p polar-render --example render_scene -- SCENE OUT_DIR [--spp N] [--model none|linear|full] [--sampler sobol|independent]`
 
-use polar_render::{Polarization, RenderOptions, load_scene, render};
+use polar_render::{Polarization, RenderOptions, SamplerKind, load_scene, render};
 use std::path::PathBuf;
 
 fn main() {
@@ -16,8 +16,8 @@ fn main() {
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: render_scene SCENE OUT_DIR [--spp N] [--model none|linear|full]";
-    let (mut positional, mut spp, mut model) = (Vec::new(), None, None);
+    let usage = "usage: render_scene SCENE OUT_DIR [--spp N] [--model none|linear|full] [--sampler sobol|independent]";
+    let (mut positional, mut spp, mut model, mut sampler) = (Vec::new(), None, None, None);
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -30,6 +30,13 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                     _ => return Err(usage.into()),
                 })
             }
+            "--sampler" => {
+                sampler = Some(match it.next().map(String::as_str) {
+                    Some("sobol") => SamplerKind::Sobol,
+                    Some("independent") => SamplerKind::Independent,
+                    _ => return Err(usage.into()),
+                })
+            }
             _ => positional.push(PathBuf::from(a)),
         }
     }
@@ -37,6 +44,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let mut scene = load_scene(&scene_path)?;
     if let Some(spp) = spp {
         scene.settings.spp = spp;
+    }
+    if let Some(sampler) = sampler {
+        scene.settings.sampler = sampler;
     }
     let out_img = render(
         &scene,
@@ -79,6 +89,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         "renderer": "polar-render",
         "model": format!("{:?}", out_img.model),
         "spp": out_img.spp,
+        "sampler": format!("{:?}", scene.settings.sampler),
         "seconds": out_img.seconds,
     });
     std::fs::write(out.join("meta.json"), serde_json::to_string_pretty(&meta)?)?;

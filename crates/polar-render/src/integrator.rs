@@ -200,7 +200,8 @@ impl Vertex<'_> {
             }
             Vertex::Medium { phase, k_out, .. } => {
                 // The density depends on k_in · k_out only: sampling about k_out gives k_in.
-                let (k_in, pdf) = phase.sample(k_out, [u[0], u[1]]);
+                // (u[1], u[2]) is the draw's 2-D point (Sampler::next_3d).
+                let (k_in, pdf) = phase.sample(k_out, [u[1], u[2]]);
                 (pdf > 0.0).then(|| Continuation {
                     wi: -k_in,
                     in_x: stokes_basis(&k_in),
@@ -234,7 +235,7 @@ fn next_event<R: Transport>(
     sum: &mut Stokes,
 ) {
     if vertex.is_delta() {
-        sampler.skip(3);
+        sampler.skip_3d();
         return;
     }
     let u_light = sampler.next_3d();

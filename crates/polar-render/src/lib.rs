@@ -26,6 +26,7 @@ mod world;
 pub use medium::{DensityGrid, Medium};
 pub use polar_bsdf::{Material, Polarization};
 pub use render::{RenderOptions, RenderOutput, render, required_model};
+pub use sampler::SamplerKind;
 pub use scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, TriangleMesh};
 pub use scene_file::{load_scene, parse_scene};
 

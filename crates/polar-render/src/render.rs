@@ -185,7 +185,8 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
     };
     for y in y0..y0 + th {
         for x in x0..x0 + tw {
-            let streams = PixelStreams::new(settings.seed, (y * cam.width + x) as u64);
+            let streams =
+                PixelStreams::new(settings.seed, (y * cam.width + x) as u64, settings.sampler);
             let mut sum = Stokes::zeros();
             for s in 0..settings.spp {
                 let mut sampler = streams.sample(u64::from(s));

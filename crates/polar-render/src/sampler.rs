@@ -1,16 +1,58 @@
-//! Counter-based random numbers: every sample is a pure function of
-//! `(seed, pixel, sample index, dimension)`, so the image does not depend on
-//! how pixels are scheduled over threads.
+//! Per-sample random numbers: every number is a pure function of
+//! `(seed, pixel, sample index, dimension)`, so the image does not depend on how
+//! pixels are scheduled over threads.
+//!
+//! Two kinds of numbers. *Aligned draws* ([`Sampler::next_1d`], `next_2d`,
+//! `next_3d`) are made in the same order by every sample of a pixel (camera jitter,
+//! then per bounce the light, the BSDF and Russian roulette), so draw `j` of every
+//! sample integrates the same dimension: with [`SamplerKind::Sobol`] they are
+//! low-discrepancy. *Free* numbers ([`Sampler::next_free`]) are drawn in
+//! data-dependent counts (delta and ratio tracking) and always come from an
+//! independent hash stream, so they never shift the aligned draws.
+//!
+//! Measured (S0 relative RMSE over the sphere pixels of the 128×128 cross-check scenes
+//! against two 8192-spp renders, their noise subtracted), independent → Sobol:
+//!
+//! | scene | 16 spp | 64 spp | 256 spp | 1024 spp |
+//! |---|---|---|---|---|
+//! | conductor | 0.094 → 0.015 % | 0.047 → 0.0030 % | 0.023 → 0.0008 % | 0.012 → 0.0002 % |
+//! | rough conductor | 5.7 → 1.7 % | 2.9 → 0.45 % | 1.4 → 0.14 % | 0.70 → 0.054 % |
+//! | pplastic | 3.0 → 1.4 % | 1.5 → 0.47 % | 0.74 → 0.17 % | 0.38 → 0.068 % |
+//! | glass | 1.8 → 1.9 % | 0.98 → 0.89 % | 0.48 → 0.49 % | 0.24 → 0.24 % |
+//!
+//! Glass gains nothing: its error comes from long chains of reflect/refract choices,
+//! each in its own padded draw. A Sobol draw costs about 350 instructions against
+//! about 30 for three hash numbers.
 
-/// One stream of uniform numbers for one pixel sample.
-#[derive(Clone, Debug)]
-pub struct Sampler {
-    key: u64,
-    dimension: u64,
+use serde::Deserialize;
+
+/// Where the aligned draws come from (`[render] sampler` in a scene file).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerKind {
+    /// Owen-scrambled Sobol points (Burley 2020, "Practical Hash-based Owen
+    /// Scrambling", crate `sobol_burley`), padded: draw `j` takes Sobol dimensions
+    /// 0–3 under its own per-pixel scramble seed, so every 2-D pair is a (0,2)-sequence
+    /// and there is no dimension limit.
+    #[default]
+    Sobol,
+    /// Independent uniform numbers (SplitMix64 of the sample key and a counter).
+    Independent,
 }
 
 /// SplitMix64's increment (the golden ratio in 64 bits).
 const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// Domain separators, so Sobol seeds and low bits never reuse a hash stream input.
+const SEED_DOMAIN: u64 = 0x5b0b_5eed_0000_0000;
+const LOW_BITS_DOMAIN: u64 = 0x10e5_b175_0000_0000;
+
+/// `sobol_burley` supports sample indices below 2^16; each further block of 2^16
+/// samples gets its own scramble seed (an independent Owen-scrambled net).
+const SOBOL_INDEX_BITS: u32 = 16;
+
+/// `2^-53`, the spacing of the f64 grid on `[0, 1)` we sample.
+const ULP_53: f64 = 1.0 / (1u64 << 53) as f64;
 
 /// SplitMix64 finaliser (Steele et al. 2014): a bijective 64-bit mixer.
 fn mix(mut z: u64) -> u64 {
@@ -21,49 +63,121 @@ fn mix(mut z: u64) -> u64 {
 
 /// The streams of every sample of one pixel: hashes the seed and pixel once.
 #[derive(Clone, Copy, Debug)]
-pub struct PixelStreams(u64);
+pub struct PixelStreams {
+    key: u64,
+    kind: SamplerKind,
+}
 
 impl PixelStreams {
-    /// The streams of pixel `pixel` under `seed`.
-    pub fn new(seed: u64, pixel: u64) -> Self {
-        Self(mix(mix(seed) ^ pixel))
+    /// The streams of pixel `pixel` under `seed`, aligned draws of kind `kind`.
+    pub fn new(seed: u64, pixel: u64, kind: SamplerKind) -> Self {
+        Self {
+            key: mix(mix(seed) ^ pixel),
+            kind,
+        }
     }
 
     /// The stream of sample `sample` (the same as [`Sampler::new`]).
     pub fn sample(&self, sample: u64) -> Sampler {
-        let key = mix(self.0 ^ sample.wrapping_mul(GAMMA));
-        Sampler { key, dimension: 0 }
+        Sampler {
+            key: mix(self.key ^ sample.wrapping_mul(GAMMA)),
+            pixel: self.key,
+            sample,
+            kind: self.kind,
+            dimension: 0,
+            draw: 0,
+        }
     }
+}
+
+/// One pixel sample's numbers.
+#[derive(Clone, Debug)]
+pub struct Sampler {
+    /// Key of this sample's hash stream.
+    key: u64,
+    /// Key of the pixel (the Sobol scramble seeds depend on it and the draw only).
+    pixel: u64,
+    sample: u64,
+    kind: SamplerKind,
+    /// Counter of the hash stream.
+    dimension: u64,
+    /// Index of the next aligned draw.
+    draw: u64,
 }
 
 impl Sampler {
     /// The stream of sample `sample` of pixel `pixel` under `seed`.
-    pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
-        PixelStreams::new(seed, pixel).sample(sample)
+    pub fn new(seed: u64, pixel: u64, sample: u64, kind: SamplerKind) -> Self {
+        PixelStreams::new(seed, pixel, kind).sample(sample)
     }
 
-    /// The next uniform number in `[0, 1)` (53 random bits): SplitMix64's output
-    /// for state `key + dimension · γ` (one mix per number).
-    pub fn next_1d(&mut self) -> f64 {
+    /// The next number of the hash stream, uniform in `[0, 1)` (53 random bits):
+    /// SplitMix64's output for state `key + dimension · γ`. For numbers drawn in
+    /// data-dependent counts.
+    pub fn next_free(&mut self) -> f64 {
         self.dimension += 1;
         let bits = mix(self.key.wrapping_add(self.dimension.wrapping_mul(GAMMA)));
-        (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+        (bits >> 11) as f64 * ULP_53
     }
 
-    /// Two numbers in `[0, 1)`.
+    /// Aligned draw of one number in `[0, 1)`.
+    pub fn next_1d(&mut self) -> f64 {
+        match self.kind {
+            SamplerKind::Sobol => self.sobol::<1>()[0],
+            SamplerKind::Independent => self.next_free(),
+        }
+    }
+
+    /// Aligned draw of a 2-D point in `[0, 1)²` (Sobol dimensions 0 and 1).
     pub fn next_2d(&mut self) -> [f64; 2] {
-        [self.next_1d(), self.next_1d()]
+        match self.kind {
+            SamplerKind::Sobol => self.sobol::<2>(),
+            SamplerKind::Independent => [self.next_free(), self.next_free()],
+        }
     }
 
-    /// Three numbers in `[0, 1)`.
+    /// Aligned draw of three numbers for "choose, then sample a 2-D point":
+    /// `u[0]` is Sobol dimension 2, `(u[1], u[2])` dimensions 0 and 1, a
+    /// (0,2)-sequence, as the BSDFs and lights use them.
     pub fn next_3d(&mut self) -> [f64; 3] {
-        [self.next_1d(), self.next_1d(), self.next_1d()]
+        match self.kind {
+            SamplerKind::Sobol => {
+                let [a, b, c] = self.sobol::<3>();
+                [c, a, b]
+            }
+            SamplerKind::Independent => [self.next_free(), self.next_free(), self.next_free()],
+        }
     }
 
-    /// Skips `n` numbers without computing them: the later numbers are the same
-    /// as if they had been drawn.
-    pub fn skip(&mut self, n: u64) {
-        self.dimension += n;
+    /// Skips one [`Self::next_3d`] draw without computing it: the later numbers
+    /// are the same as if it had been drawn.
+    pub fn skip_3d(&mut self) {
+        match self.kind {
+            SamplerKind::Sobol => self.draw += 1,
+            SamplerKind::Independent => self.dimension += 3,
+        }
+    }
+
+    /// The first `N` dimensions of this sample's point in the padded Sobol set of
+    /// the next draw, as f64.
+    ///
+    /// `sobol_burley` returns f32 multiples of `2^-23` (23 bits; checked by a test).
+    /// Below the net's resolution an Owen scramble makes every further digit an
+    /// independent fair bit, so we continue the scramble with 30 hash bits:
+    /// `x + r · 2^-53`, `r < 2^30`, which is exact in f64, uniform on the `2^-53`
+    /// grid of `[0, 1)` and at most `1 − 2^-53` (never 1).
+    fn sobol<const N: usize>(&mut self) -> [f64; N] {
+        let block = self.sample >> SOBOL_INDEX_BITS;
+        let index = (self.sample & ((1 << SOBOL_INDEX_BITS) - 1)) as u32;
+        let seed_input = SEED_DOMAIN ^ (self.draw | block << 32).wrapping_mul(GAMMA);
+        let seed = (mix(self.pixel ^ seed_input) >> 32) as u32;
+        let x = sobol_burley::sample_4d(index, 0, seed);
+        let low_key = self.key ^ LOW_BITS_DOMAIN ^ (4 * self.draw).wrapping_mul(GAMMA);
+        self.draw += 1;
+        std::array::from_fn(|lane| {
+            let r = mix(low_key.wrapping_add((lane as u64).wrapping_mul(GAMMA))) >> 34;
+            f64::from(x[lane]) + r as f64 * ULP_53
+        })
     }
 }
 
@@ -71,38 +185,153 @@ impl Sampler {
 mod tests {
     use super::*;
 
+    const KINDS: [SamplerKind; 2] = [SamplerKind::Sobol, SamplerKind::Independent];
+
+    fn draws(kind: SamplerKind, sample: u64) -> Vec<f64> {
+        let mut s = Sampler::new(1, 2, sample, kind);
+        (0..4).flat_map(|_| s.next_3d()).collect()
+    }
+
     #[test]
     fn streams_are_reproducible_and_distinct() {
-        let a: Vec<f64> = (0..4)
-            .map(|_| 0.0)
-            .scan(Sampler::new(1, 2, 3), |s, _| Some(s.next_1d()))
-            .collect();
-        let b: Vec<f64> = (0..4)
-            .map(|_| 0.0)
-            .scan(Sampler::new(1, 2, 3), |s, _| Some(s.next_1d()))
-            .collect();
-        let c: Vec<f64> = (0..4)
-            .map(|_| 0.0)
-            .scan(Sampler::new(1, 2, 4), |s, _| Some(s.next_1d()))
-            .collect();
-        assert_eq!(a, b);
-        assert_ne!(a, c);
+        for kind in KINDS {
+            assert_eq!(draws(kind, 3), draws(kind, 3));
+            assert_ne!(draws(kind, 3), draws(kind, 4));
+        }
     }
 
     #[test]
     fn skip_is_drawing_and_discarding() {
-        let (mut a, mut b) = (Sampler::new(1, 2, 3), Sampler::new(1, 2, 3));
-        a.next_3d();
-        b.skip(3);
-        assert_eq!(a.next_1d(), b.next_1d());
+        for kind in KINDS {
+            let (mut a, mut b) = (Sampler::new(1, 2, 3, kind), Sampler::new(1, 2, 3, kind));
+            a.next_3d();
+            b.skip_3d();
+            assert_eq!(a.next_1d(), b.next_1d());
+        }
+    }
+
+    #[test]
+    fn free_numbers_leave_sobol_draws_aligned() {
+        let (mut a, mut b) = (
+            Sampler::new(1, 2, 3, SamplerKind::Sobol),
+            Sampler::new(1, 2, 3, SamplerKind::Sobol),
+        );
+        a.next_free();
+        assert_eq!(a.next_3d(), b.next_3d());
     }
 
     #[test]
     fn mean_of_uniforms_is_one_half() {
-        // 10^5 samples: the standard error of the mean is 0.289/sqrt(1e5) ~ 9e-4; allow 5 sigma.
-        let mut s = Sampler::new(7, 0, 0);
+        // 10^5 numbers (aligned draws over samples, free numbers of one sample): the
+        // standard error of the mean is 0.289/sqrt(1e5) ~ 9e-4; allow 5 sigma.
         let n = 100_000;
-        let mean = (0..n).map(|_| s.next_1d()).sum::<f64>() / n as f64;
-        assert!((mean - 0.5).abs() < 4.5e-3, "mean {mean}");
+        for kind in KINDS {
+            let streams = PixelStreams::new(7, 0, kind);
+            let aligned = (0..n).map(|i| streams.sample(i).next_1d()).sum::<f64>();
+            let mut s = streams.sample(0);
+            let free = (0..n).map(|_| s.next_free()).sum::<f64>();
+            for sum in [aligned, free] {
+                let mean = sum / n as f64;
+                assert!((mean - 0.5).abs() < 4.5e-3, "{kind:?}: mean {mean}");
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_crate_returns_multiples_of_2_pow_minus_23() {
+        // The low-bit filling in `Sampler::sobol` is exact only for such values.
+        for i in 0..4096 {
+            for x in sobol_burley::sample_4d(i, 0, i.wrapping_mul(0x9e37_79b9)) {
+                let scaled = f64::from(x) * (1u64 << 23) as f64;
+                assert!((0.0..1.0).contains(&x) && scaled.fract() == 0.0, "{x}");
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_numbers_have_53_bits_and_stay_below_one() {
+        // Every number lies in [0, 1); the bits below 2^-23 are filled: their mean over
+        // 2^14 numbers is 0.5 within 5 sigma (sigma = 0.289 / 128).
+        let streams = PixelStreams::new(3, 5, SamplerKind::Sobol);
+        let n = 1 << 14;
+        let mut low_sum = 0.0;
+        for i in 0..n {
+            for x in streams.sample(i).next_3d() {
+                assert!((0.0..1.0).contains(&x), "{x}");
+                low_sum += (x * (1u64 << 23) as f64).fract();
+            }
+        }
+        let low_mean = low_sum / (3 * n) as f64;
+        assert!((low_mean - 0.5).abs() < 5.0 * 0.289 / 128.0, "{low_mean}");
+    }
+
+    /// Whether `points` (2^m of them) form a (0,m,2)-net in base 2: exactly one point
+    /// in each elementary interval `[a/2^k, (a+1)/2^k) × [b/2^(m−k), (b+1)/2^(m−k))`.
+    fn is_net(points: &[[f64; 2]]) -> bool {
+        let m = points.len().trailing_zeros();
+        assert_eq!(points.len(), 1 << m);
+        (0..=m).all(|k| {
+            let mut seen = vec![false; points.len()];
+            points.iter().all(|p| {
+                let a = (p[0] * (1u64 << k) as f64) as usize;
+                let b = (p[1] * (1u64 << (m - k)) as f64) as usize;
+                !std::mem::replace(&mut seen[(a << (m - k)) | b], true)
+            })
+        })
+    }
+
+    /// The first `2^m` samples (from `first`) of the 2-D part of aligned draw `draw`.
+    fn draw_points(
+        kind: SamplerKind,
+        pixel: u64,
+        draw: usize,
+        first: u64,
+        m: u32,
+    ) -> Vec<[f64; 2]> {
+        let streams = PixelStreams::new(11, pixel, kind);
+        (first..first + (1 << m))
+            .map(|i| {
+                let mut s = streams.sample(i);
+                (0..draw).for_each(|_| s.skip_3d());
+                let u = s.next_3d();
+                [u[1], u[2]]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn sobol_draws_are_0_m_2_nets_and_independent_ones_are_not() {
+        for pixel in [0, 1, 1000] {
+            for draw in [0, 1, 7] {
+                for m in 0..=10 {
+                    assert!(
+                        is_net(&draw_points(SamplerKind::Sobol, pixel, draw, 0, m)),
+                        "pixel {pixel}, draw {draw}, 2^{m} samples"
+                    );
+                }
+                // Samples past 2^16 start a new net.
+                let far = draw_points(SamplerKind::Sobol, pixel, draw, 1 << 16, 8);
+                assert!(is_net(&far));
+                // The test can fail: 256 independent points are (almost surely) not a net.
+                assert!(!is_net(&draw_points(
+                    SamplerKind::Independent,
+                    pixel,
+                    draw,
+                    0,
+                    8
+                )));
+            }
+        }
+        // The camera draw (the first one) is a net as well.
+        let streams = PixelStreams::new(0, 42, SamplerKind::Sobol);
+        let camera: Vec<[f64; 2]> = (0..1024).map(|i| streams.sample(i).next_2d()).collect();
+        assert!(is_net(&camera));
+    }
+
+    #[test]
+    fn neighbouring_pixels_and_draws_get_other_points() {
+        let first = |pixel, draw| draw_points(SamplerKind::Sobol, pixel, draw, 0, 4);
+        assert_ne!(first(0, 0), first(1, 0));
+        assert_ne!(first(0, 0), first(0, 1));
     }
 }

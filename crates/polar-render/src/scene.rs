@@ -7,6 +7,7 @@
 //! propagation direction `k` (as Mitsuba 3 does for its polarized emitters).
 
 use crate::medium::Medium;
+use crate::sampler::SamplerKind;
 use crate::{Error, Material};
 use nalgebra::{Matrix4, Vector3};
 use polar_optics::OpticsError;
@@ -43,6 +44,8 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Maximum number of scattering events on a path (1 = direct lighting only).
     pub max_depth: u32,
+    /// Where the sample points come from (Owen-scrambled Sobol by default).
+    pub sampler: SamplerKind,
 }
 
 impl Default for RenderSettings {
@@ -51,6 +54,7 @@ impl Default for RenderSettings {
             spp: 64,
             seed: 0,
             max_depth: 8,
+            sampler: SamplerKind::Sobol,
         }
     }
 }

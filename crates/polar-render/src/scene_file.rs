@@ -4,6 +4,7 @@
 
 use crate::Error;
 use crate::medium::{DensityGrid, Medium, phase_key};
+use crate::sampler::SamplerKind;
 use crate::scene::{
     Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, Vec3, sky_key,
 };
@@ -103,6 +104,8 @@ struct RenderDesc {
     seed: u64,
     #[serde(default = "default_max_depth")]
     max_depth: u32,
+    #[serde(default)]
+    sampler: SamplerKind,
 }
 
 fn default_spp() -> u32 {
@@ -120,6 +123,7 @@ impl Default for RenderDesc {
             spp: s.spp,
             seed: s.seed,
             max_depth: s.max_depth,
+            sampler: s.sampler,
         }
     }
 }
@@ -258,6 +262,7 @@ fn build(desc: SceneFile, file: &Path, base: &Path) -> Result<Scene, Error> {
         spp: desc.render.spp,
         seed: desc.render.seed,
         max_depth: desc.render.max_depth,
+        sampler: desc.render.sampler,
     };
     scene.sensor = desc.sensor;
     let names: Vec<String> = desc.materials.keys().cloned().collect();

@@ -39,9 +39,10 @@ pub(crate) fn clip(m: &Medium, o: &Vec3, d: &Vec3, t_max: f64) -> Option<(f64, f
     (t0 < t1).then_some((t0, t1))
 }
 
-/// An exponential step of rate `rate` (`rate > 0`).
+/// An exponential step of rate `rate` (`rate > 0`). Tracking draws its numbers in
+/// data-dependent counts, so from the sampler's free stream.
 fn step(rate: f64, sampler: &mut Sampler) -> f64 {
-    -(1.0 - sampler.next_1d()).ln() / rate
+    -(1.0 - sampler.next_free()).ln() / rate
 }
 
 /// Samples the first scattering event along `o + t d`, `t < t_max`. Homogeneous:
@@ -77,7 +78,7 @@ pub(crate) fn flight<'a>(
         // Homogeneous: every tentative collision is real (no random number spent).
         let real = match &m.density {
             None => true,
-            Some(_) => sampler.next_1d() * majorant < m.sigma_t() * m.density_at(&(o + t * d)),
+            Some(_) => sampler.next_free() * majorant < m.sigma_t() * m.density_at(&(o + t * d)),
         };
         if real {
             return Flight::Scatter {

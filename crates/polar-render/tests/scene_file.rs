@@ -1,7 +1,7 @@
 //! Scene-file parsing: every example scene loads, meshes load from PLY and OBJ,
 //! and each kind of bad input gives an error naming the file, the key and the reason.
 
-use polar_render::{Error, Geometry, load_scene, parse_scene};
+use polar_render::{Error, Geometry, SamplerKind, load_scene, parse_scene};
 use std::path::{Path, PathBuf};
 
 const HEADER: &str = r#"
@@ -33,6 +33,15 @@ fn unknown_key_is_named() {
     assert_names(err, "radiuss", "unknown field");
     let err = parse("[render]\nsamples = 4\n").unwrap_err();
     assert_names(err, "samples", "unknown field");
+}
+
+#[test]
+fn sampler_key_is_read_and_checked() {
+    assert_eq!(parse("").unwrap().settings.sampler, SamplerKind::Sobol);
+    let scene = parse("[render]\nsampler = \"independent\"\n").unwrap();
+    assert_eq!(scene.settings.sampler, SamplerKind::Independent);
+    let err = parse("[render]\nsampler = \"halton\"\n").unwrap_err();
+    assert_names(err, "sampler", "unknown variant `halton`");
 }
 
 #[test]
