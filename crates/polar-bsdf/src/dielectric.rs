@@ -4,14 +4,19 @@
 //!
 //! Transmission carries radiance: the flux-unit Fresnel matrix is scaled by
 //! `1/η²` with `η = n(wi side) / n(wo side)` (the `eta` of the sample).
+//!
+//! Reflection or transmission is chosen with the unpolarized Fresnel reflectance
+//! or, given the camera row of the path (`importance`), for the S0 each brings
+//! to the camera (crate `lobe`); `pdf` and `sample` agree either way.
 
 use crate::geometry::{
-    V3, from_sp_frame, reflect, reflect_z, reflectance, reflection, refract, transmission,
+    V3, from_sp_frame, reflect, reflect_z, reflection, refract, sp_column_to_wo_basis, transmission,
 };
+use crate::lobe::first_lobe_probability;
 use crate::microfacet::Ggx;
 use crate::{BsdfSample, Model, Polarization};
-use polar_optics::Mueller;
 use polar_optics::fresnel::fresnel_amplitudes;
+use polar_optics::{Mueller, Stokes};
 
 /// A dielectric interface: smooth when `roughness` is `None`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,12 +25,26 @@ pub struct Dielectric {
     pub eta: f64,
     /// Microfacet distribution; `None` for a smooth interface.
     pub roughness: Option<Ggx>,
+    /// First row of the path throughput in the output basis of the `wo` this
+    /// BSDF is sampled for ([`crate::Bsdf::with_importance`]); `None` chooses
+    /// lobes by unpolarized reflectance.
+    pub importance: Option<Stokes>,
 }
 
 impl Dielectric {
     /// `n(other side) / n(side of w)`.
     fn etap(&self, w: &V3) -> f64 {
         if w.z > 0.0 { self.eta } else { 1.0 / self.eta }
+    }
+
+    /// Probability of reflection given the reflected column `c_r` (unpolarized
+    /// input, output basis of `wo`): the other lobe's flux-unit column is
+    /// `e0 − c_r` for a lossless interface (`R + T = 1` per s and p, tested in polar-optics).
+    fn reflect_prob_of(&self, c_r: &Stokes) -> f64 {
+        match &self.importance {
+            Some(t) => first_lobe_probability(c_r[0], c_r, &(Stokes::x() - c_r), t),
+            None => c_r[0],
+        }
     }
 
     /// One Fresnel evaluation serves both lobes: the flux-unit transmission
@@ -36,7 +55,7 @@ impl Dielectric {
         let wr = reflect_z(wo);
         let fresnel = fresnel_amplitudes(wo.z.abs(), etap.into());
         let r_mueller = from_sp_frame(&fresnel.reflection_block(), &V3::z(), wo, &wr);
-        let r = r_mueller[(0, 0)];
+        let r = self.reflect_prob_of(&r_mueller.column(0).into_owned());
         let n = V3::z() * wo.z.signum();
         match refract(wo, &n, etap) {
             Some(wt) if u >= r => {
@@ -77,10 +96,14 @@ impl Dielectric {
         front.then_some((h, etap))
     }
 
-    /// Probability of choosing reflection at microfacet `h`: the unpolarized
-    /// Fresnel reflectance for light arriving from the side of `wo`.
+    /// Probability of choosing reflection at microfacet `h`, for light arriving
+    /// from the side of `wo` ([`Self::reflect_prob_of`] at the facet).
     fn reflect_prob(&self, wo: &V3, h: &V3) -> f64 {
-        reflectance(wo.dot(h).abs(), self.etap(wo))
+        let c_r = fresnel_amplitudes(wo.dot(h).abs(), self.etap(wo).into()).reflected_unpolarized();
+        if self.importance.is_none() {
+            return c_r[0];
+        }
+        self.reflect_prob_of(&sp_column_to_wo_basis(&c_r, h, wo))
     }
 
     fn rough_eval(&self, ggx: &Ggx, wo: &V3, wi: &V3) -> Mueller {

@@ -126,18 +126,19 @@ pub(crate) fn from_sp_frame(f: &BlockDiagonal, m: &V3, wo: &V3, wi: &V3) -> Muel
     f.rotated(out, inp)
 }
 
+/// Column 0 of [`from_sp_frame`] (light leaving along `wo`, any `wi` in the
+/// plane of `m` and `wo`) from column 0 `c` in the s/p frame at `m`: the output
+/// of the interface for unpolarized input, which only needs the output rotation.
+pub(crate) fn sp_column_to_wo_basis(c: &Stokes, m: &V3, wo: &V3) -> Stokes {
+    rotate_stokes(c, double_angle(wo, &s_axis(m, wo), &stokes_basis(wo)))
+}
+
 /// Fresnel transmission (energy-flux units, no radiance scaling) at the
 /// (micro)normal `m` of light arriving along `-wi` and leaving along `wo`, for the
 /// real relative index `eta = n_wo_side / n_wi_side`, in the BSDF bases.
 pub(crate) fn transmission(eta: f64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
     let f = fresnel_amplitudes(wi.dot(m).abs(), eta.into()).transmission_block();
     from_sp_frame(&f, m, wo, wi)
-}
-
-/// Unpolarized reflectance `(R_s + R_p) / 2` of light arriving at `cos_i` for relative index `eta`.
-pub(crate) fn reflectance(cos_i: f64, eta: f64) -> f64 {
-    let (rs, rp) = fresnel_amplitudes(cos_i, eta.into()).reflectance();
-    0.5 * (rs + rp)
 }
 
 /// A Mueller matrix that only keeps intensity: `value` at (0, 0), zero elsewhere

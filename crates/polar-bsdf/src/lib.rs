@@ -30,6 +30,7 @@ mod dielectric;
 mod error;
 mod geometry;
 mod lambertian;
+mod lobe;
 mod material;
 pub mod microfacet;
 mod plastic;
@@ -47,7 +48,7 @@ pub use plastic::Plastic;
 pub use sheet::{Sheet, SheetKind};
 
 use nalgebra::Vector3;
-use polar_optics::Mueller;
+use polar_optics::{Mueller, Stokes};
 
 /// The cheapest exact light-transport model a BSDF needs, ordered
 /// `None < Linear < Full` so a scene needs the maximum over its materials.
@@ -145,6 +146,26 @@ impl Bsdf {
     /// picks a lobe where there are several). `None` when no light can arrive.
     pub fn sample(&self, wo: &Vector3<f64>, u: [f64; 3]) -> Option<BsdfSample> {
         self.model().sample(wo, u)
+    }
+
+    /// This BSDF with its lobe choice made for what the camera measures: `t` is
+    /// the first row of the path throughput (the S0 at the camera per unit of
+    /// each Stokes component leaving along `wo`) in the output basis of `wo`.
+    /// [`Self::sample`] and [`Self::pdf`] then weigh each lobe by the S0 it
+    /// brings to the camera (glass: reflection against flux transmission, with
+    /// probability `t · c_k / t_0` for column `c_k`; plastic: Mitsuba's specular
+    /// probability reweighed by the same factor), and agree with each other, so
+    /// MIS stays exact. Valid for this `wo` only; models with one lobe are
+    /// returned unchanged.
+    pub fn with_importance(&self, wo: &Vector3<f64>, t: &Stokes) -> Bsdf {
+        match self {
+            Bsdf::Dielectric(d) => Bsdf::Dielectric(Dielectric {
+                importance: Some(*t),
+                ..*d
+            }),
+            Bsdf::Plastic(p) => Bsdf::Plastic(p.with_importance(wo, t)),
+            Bsdf::Lambertian(_) | Bsdf::Conductor(_) | Bsdf::Sheet(_) => *self,
+        }
     }
 
     /// Whether some lobe is a delta (then light sampling cannot reach that lobe).

@@ -405,6 +405,7 @@ impl Material {
             Material::Dielectric(p) => Bsdf::Dielectric(Dielectric {
                 eta: p.ior / p.ext_ior,
                 roughness: p.roughness.distribution(),
+                importance: None,
             }),
             Material::Plastic(p) => Bsdf::Plastic(Plastic {
                 eta: p.ior / p.ext_ior,

@@ -12,17 +12,20 @@
 //! The two lobes are added (not energy conserving, as the original) and sampled
 //! as Mitsuba does: the specular lobe with probability `specular_prob`
 //! (`1 / (1 + mean albedo)`), the diffuse lobe by cosine sampling, and the
-//! weight of a non-delta sample is the full `eval / pdf` of the mixture.
+//! weight of a non-delta sample is the full `eval / pdf` of the mixture. Given the
+//! camera row of the path, [`Plastic::with_importance`] reweighs that probability
+//! by the S0 each lobe brings to the camera (crate `lobe`).
 
 use crate::conductor::{microfacet_reflection, microfacet_reflection_pdf};
 use crate::geometry::{
     V3, cosine_hemisphere, cosine_hemisphere_pdf, rank_one_to_bsdf_bases, reflect, reflect_z,
-    reflection, s_axis,
+    reflection, s_axis, sp_column_to_wo_basis,
 };
+use crate::lobe::first_lobe_probability;
 use crate::microfacet::Ggx;
 use crate::{BsdfSample, Model, Polarization};
-use polar_optics::Mueller;
 use polar_optics::fresnel::fresnel_amplitudes;
+use polar_optics::{Mueller, Stokes};
 use std::f64::consts::FRAC_1_PI;
 
 /// Polarized plastic at one surface point.
@@ -45,22 +48,44 @@ impl Plastic {
             return Mueller::zeros();
         }
         let t_in = fresnel_amplitudes(wi.z, self.eta.into()).transmitted_unpolarized();
-        // The internal direction that refracts out along wo.
-        let cos_inside = (1.0 - (1.0 - wo.z * wo.z) / (self.eta * self.eta))
-            .max(0.0)
-            .sqrt();
-        let t_out =
-            fresnel_amplitudes(cos_inside, (1.0 / self.eta).into()).transmitted_unpolarized();
         // D = diag(1, 0, 0, 0) keeps column 0 of T_out and row 0 of T_in: rank one.
         let k_in = -wi;
         rank_one_to_bsdf_bases(
-            &t_out,
+            &self.exit_transmission(wo),
             &(t_in * (self.albedo * wi.z * FRAC_1_PI)),
             &k_in,
             &s_axis(&V3::z(), &k_in),
             wo,
             &s_axis(&V3::z(), wo),
         )
+    }
+
+    /// Column 0 of `T_out(θo)` in the s/p frame: unpolarized light from inside
+    /// (the internal direction that refracts out along `wo`) leaving along `wo`.
+    fn exit_transmission(&self, wo: &V3) -> Stokes {
+        let cos_inside = (1.0 - (1.0 - wo.z * wo.z) / (self.eta * self.eta))
+            .max(0.0)
+            .sqrt();
+        fresnel_amplitudes(cos_inside, (1.0 / self.eta).into()).transmitted_unpolarized()
+    }
+
+    /// This plastic with `specular_prob` reweighed for the camera row `t` (first
+    /// row of the path throughput in the output basis of `wo`). The diffuse lobe's
+    /// column is exact (its polarization is the exit transmission's, whatever
+    /// `wi`); the specular one is the coating's Fresnel reflection at `wo`, exact
+    /// when smooth and the smooth limit when rough (where only the choice, not the
+    /// estimate, depends on it: `pdf` and `sample` use the same probability).
+    pub fn with_importance(&self, wo: &V3, t: &Stokes) -> Self {
+        if wo.z <= 0.0 {
+            return *self;
+        }
+        let specular = fresnel_amplitudes(wo.z, self.eta.into()).reflected_unpolarized();
+        let c_s = sp_column_to_wo_basis(&specular, &V3::z(), wo);
+        let c_d = sp_column_to_wo_basis(&self.exit_transmission(wo), &V3::z(), wo);
+        Self {
+            specular_prob: first_lobe_probability(self.specular_prob, &c_s, &c_d, t),
+            ..*self
+        }
     }
 
     fn diffuse_prob(&self) -> f64 {

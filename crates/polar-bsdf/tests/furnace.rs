@@ -138,6 +138,7 @@ fn smooth_lossless_dielectric_r_plus_t_is_one_for_s_p_and_unpolarized() {
     let bsdf = Bsdf::Dielectric(Dielectric {
         eta: 1.5,
         roughness: None,
+        importance: None,
     });
     for theta in [
         0.0, 10.0, 40.0, 56.31, 70.0, 89.0, 100.0, 130.0, 139.0, 160.0, 180.0,

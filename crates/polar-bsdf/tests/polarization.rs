@@ -49,6 +49,7 @@ fn brewster_reflection_is_fully_s_polarized() {
     let glass = Bsdf::Dielectric(Dielectric {
         eta,
         roughness: None,
+        importance: None,
     });
     let plastic = Bsdf::Plastic(Plastic {
         eta,

@@ -45,10 +45,12 @@ fn rough_lobes_converge_to_smooth_fresnel_matrices() {
             Bsdf::Dielectric(Dielectric {
                 eta: 1.5,
                 roughness: Some(Ggx::new(ALPHA, ALPHA)),
+                importance: None,
             }),
             Bsdf::Dielectric(Dielectric {
                 eta: 1.5,
                 roughness: None,
+                importance: None,
             }),
         ),
         (

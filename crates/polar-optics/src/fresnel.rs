@@ -229,6 +229,13 @@ impl FresnelAmplitudes {
         BlockDiagonal::from_diagonal_jones(self.r_s, self.r_p)
     }
 
+    /// First column of [`Self::reflection_mueller`], unpolarized unit light
+    /// reflected: `((R_s + R_p)/2, (R_s − R_p)/2, 0, 0)` (what a lobe choice needs).
+    pub fn reflected_unpolarized(&self) -> Stokes {
+        let (r_s, r_p) = self.reflectance();
+        Stokes::new(0.5 * (r_s + r_p), 0.5 * (r_s - r_p), 0.0, 0.0)
+    }
+
     /// Phase retardance of reflection `arg(r_s) − arg(r_p)` wrapped to `(−π, π]`.
     /// Under total internal reflection (`η < 1`, `sin θi > η`) it obeys
     /// `tan(δ/2) = cos θi sqrt(sin²θi − η²) / sin²θi` (Born & Wolf §1.5.4).
@@ -285,6 +292,23 @@ mod tests {
             assert!(
                 (m.row(0).transpose() - s).amax() < 1e-15,
                 "cos {cos_i}, eta {eta}"
+            );
+        }
+    }
+
+    #[test]
+    fn reflected_unpolarized_is_the_first_column_and_completes_transmission() {
+        // Column 0 of R plus flux T is unpolarized unit light for a lossless
+        // interface (R_s + T_s = R_p + T_p = 1), also under TIR (no transmission);
+        // 1e-15: a few roundings of numbers of order 1.
+        for (cos_i, eta) in [(0.9, 1.5), (0.3, 1.5), (0.7, 1.0 / 1.5), (0.2, 1.0 / 1.5)] {
+            let f = fresnel_amplitudes(cos_i, Complex64::new(eta, 0.0));
+            let r = f.reflected_unpolarized();
+            assert!((f.reflection_mueller().column(0) - r).amax() < 1e-15);
+            let sum = r + f.transmitted_unpolarized();
+            assert!(
+                (sum - Stokes::x()).amax() < 1e-15,
+                "cos {cos_i}, eta {eta}: {sum}"
             );
         }
     }

@@ -22,7 +22,7 @@ use crate::tracking::Flight;
 use crate::transport::Transport;
 use crate::world::World;
 use polar_bsdf::{Bsdf, Polarization};
-use polar_optics::frame::double_angle;
+use polar_optics::frame::{double_angle, rotate_stokes};
 use polar_optics::scatter::PhaseFunction;
 use polar_optics::{Mueller, Stokes, rotate_stokes_basis, stokes_basis};
 
@@ -104,6 +104,10 @@ impl Bounce {
 /// A scattering vertex: a surface point with its BSDF (in the shading frame), or
 /// a point in the medium with its phase function. Directions `wi` are world
 /// vectors toward where the light comes from.
+#[expect(
+    clippy::large_enum_variant,
+    reason = "one vertex per bounce, on the stack: boxing the surface would allocate per bounce"
+)]
 enum Vertex<'a> {
     Surface {
         hit: SurfaceHit,
@@ -213,6 +217,16 @@ impl Vertex<'_> {
         }
     }
 
+    /// Makes a surface's lobe choice follow what the camera measures, given the
+    /// first row `t` of the throughput in the path frame and the rotation of
+    /// this vertex's output basis into it: as a row, `t · rotator(θ)` is `t`
+    /// rotated by `−θ` (see [`Bsdf::with_importance`]).
+    fn aim(&mut self, t: &Stokes, (cos2, sin2): (f64, f64)) {
+        if let Vertex::Surface { bsdf, wo, .. } = self {
+            *bsdf = bsdf.with_importance(wo, &rotate_stokes(t, (cos2, -sin2)));
+        }
+    }
+
     /// Origin of a ray leaving the vertex along `wi` (off the surface).
     fn spawn(&self, wi: &Vec3) -> Vec3 {
         match self {
@@ -293,7 +307,7 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
     let mut bounce = Bounce::Specular;
     for depth in 0..=settings.max_depth {
         let hit = world.intersect(&o, &d);
-        let vertex = match world.flight(&o, &d, hit.as_ref(), sampler) {
+        let mut vertex = match world.flight(&o, &d, hit.as_ref(), sampler) {
             Flight::Scatter { t, weight, medium } => {
                 throughput = Some(throughput.unwrap_or_else(R::identity).scaled(weight));
                 Vertex::Medium {
@@ -345,6 +359,12 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
         } else {
             double_angle(&-d, &vertex.out_x(), &path_frame(path_x))
         };
+        // An identity throughput (first vertex) sees unpolarized: the old choice.
+        if R::MODEL != Polarization::None
+            && let Some(t) = &throughput
+        {
+            vertex.aim(&t.first_row(), out_rotation);
+        }
         let to_path = |m: &Mueller| R::from_rotated(m, out_rotation);
         next_event(
             world,

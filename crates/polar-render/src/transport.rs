@@ -38,6 +38,9 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn scaled(&self, k: f64) -> Self;
     /// `M00`: the path's response to unpolarized light (for Russian roulette).
     fn m00(&self) -> f64;
+    /// The first row as a full Stokes vector (zeros for dropped components): the
+    /// S0 at the camera per unit of each Stokes component entering the path.
+    fn first_row(&self) -> Stokes;
 }
 
 /// Scalar (unpolarized) transport.
@@ -83,6 +86,9 @@ impl Transport for Scalar {
     fn m00(&self) -> f64 {
         self.0
     }
+    fn first_row(&self) -> Stokes {
+        Stokes::new(self.0, 0.0, 0.0, 0.0)
+    }
 }
 
 impl Transport for Linear {
@@ -120,6 +126,9 @@ impl Transport for Linear {
     fn m00(&self) -> f64 {
         self.0[(0, 0)]
     }
+    fn first_row(&self) -> Stokes {
+        Stokes::new(self.0[(0, 0)], self.0[(0, 1)], self.0[(0, 2)], 0.0)
+    }
 }
 
 impl Transport for Full {
@@ -151,6 +160,9 @@ impl Transport for Full {
     }
     fn m00(&self) -> f64 {
         self.0[(0, 0)]
+    }
+    fn first_row(&self) -> Stokes {
+        self.0.row(0).transpose()
     }
 }
 

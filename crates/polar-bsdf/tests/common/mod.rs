@@ -67,6 +67,7 @@ pub fn smooth_lobed() -> Vec<(&'static str, Bsdf)> {
             Bsdf::Dielectric(Dielectric {
                 eta: 1.5,
                 roughness: Some(Ggx::new(0.3, 0.3)),
+                importance: None,
             }),
         ),
         (
@@ -74,6 +75,7 @@ pub fn smooth_lobed() -> Vec<(&'static str, Bsdf)> {
             Bsdf::Dielectric(Dielectric {
                 eta: 1.33,
                 roughness: Some(Ggx::new(0.2, 0.45)),
+                importance: None,
             }),
         ),
         (
@@ -112,6 +114,7 @@ pub fn delta_only() -> Vec<(&'static str, Bsdf)> {
             Bsdf::Dielectric(Dielectric {
                 eta: 1.5,
                 roughness: None,
+                importance: None,
             }),
         ),
         (
