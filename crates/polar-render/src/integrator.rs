@@ -187,7 +187,9 @@ impl Vertex<'_> {
         }
     }
 
-    /// Samples the direction the path continues in.
+    /// Samples the direction the path continues in. Inlined into the path loop, so
+    /// that its result is not written to memory and read back.
+    #[inline(always)]
     fn sample(&self, u: [f64; 3]) -> Option<Continuation> {
         match self {
             Vertex::Surface {
