@@ -150,71 +150,67 @@ fn specular_sphere_dolp_and_aolp_follow_fresnel() {
     assert!(max_dolp > 0.98, "max DoLP {max_dolp}");
 }
 
-#[test]
-fn glass_sphere_in_a_constant_environment_has_no_lobe_choice_variance() {
-    // A lossless sphere in a uniform unpolarized environment of radiance 1: every
-    // path that escapes brings S0 = 1 exactly when each Fresnel lobe is chosen
-    // for the S0 it brings to the camera (polar-bsdf `with_importance`), however
-    // polarized the path is. max_depth 4 stays below Russian roulette, so with
-    // one sample per pixel each S0 is 1 or, for a path still inside at the depth
-    // limit (near the outline), 0. Choosing by unpolarized reflectance gave
-    // neither on 81% of these pixels (measured with 48 seeds); f32 output: 1e-6.
+/// S0 of single paths (one sample per pixel, seeds 0..4) through a lossless glass
+/// sphere (n = 1.5) in a uniform unpolarized environment of radiance 1, seen from
+/// distance 4 with field of view `fov_deg` on `size`² pixels.
+fn glass_sphere_path_s0(fov_deg: f64, size: usize, max_depth: u32) -> Vec<f64> {
     let mat = Material::Dielectric(DielectricParams {
         ior: 1.5,
         ext_ior: 1.0,
         roughness: Roughness::Isotropic(0.0),
     });
-    let mut scene = sphere_scene(camera(4.0, 25.0, 16), mat, 1.0);
+    let mut scene = sphere_scene(camera(4.0, fov_deg, size), mat, 1.0);
     scene.settings.spp = 1;
-    scene.settings.max_depth = 4;
-    let (mut escaped, mut pixels) = (0, 0);
-    for seed in 0..4 {
-        scene.settings.seed = seed;
-        let out = run(&scene);
-        assert_eq!(out.model, polar_render::Polarization::Full);
-        for p in out.stokes.pixels() {
-            let s0 = f64::from(p[0]);
-            assert!(
-                s0.abs() < 1e-6 || (s0 - 1.0).abs() < 1e-6,
-                "seed {seed}: S0 = {s0}"
-            );
-            escaped += usize::from(s0 > 0.5);
-            pixels += 1;
-        }
+    scene.settings.max_depth = max_depth;
+    (0..4)
+        .flat_map(|seed| {
+            scene.settings.seed = seed;
+            let out = run(&scene);
+            assert_eq!(out.model, polar_render::Polarization::Full);
+            out.stokes
+                .pixels()
+                .iter()
+                .map(|p| f64::from(p[0]))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+#[test]
+fn glass_sphere_in_a_constant_environment_has_no_lobe_choice_variance() {
+    // Every path that escapes the lossless sphere brings S0 = 1 exactly when each
+    // Fresnel lobe is chosen for the S0 it brings to the camera (polar-bsdf
+    // `with_importance`), however polarized the path is. max_depth 4 stays below
+    // Russian roulette, so each S0 is 1 or, for a path still inside at the depth
+    // limit (near the outline), 0. Choosing by unpolarized reflectance gave
+    // neither on 81% of these pixels (measured with 48 seeds); f32 output: 1e-6.
+    let s0 = glass_sphere_path_s0(25.0, 16, 4);
+    for v in &s0 {
+        assert!(v.abs() < 1e-6 || (v - 1.0).abs() < 1e-6, "S0 = {v}");
     }
+    let escaped = s0.iter().filter(|&&v| v > 0.5).count();
     assert!(
-        escaped * 100 > 95 * pixels,
-        "only {escaped} of {pixels} paths escaped"
+        escaped * 100 > 95 * s0.len(),
+        "only {escaped} of {} paths escaped",
+        s0.len()
     );
 }
 
 #[test]
 fn russian_roulette_inside_glass_weighs_the_throughput_by_eta_squared() {
-    // The scene above with Russian roulette on (from depth 5): inside glass the
+    // The sphere with Russian roulette on (from depth 5): inside glass the
     // throughput's S0 is 1/n² of what an escaping path brings, so the survival
     // probability must be T00·η² (clamped to 0.95), not T00. Then every path S0 is 0
     // (cut at max_depth or killed) or 0.95^-k after k roulette survivals; with T00
     // alone a survivor inside the glass would weigh n² = 2.25 instead (S0 = 2.368
     // seen). The outline's near-total internal reflection gives the deep paths (at
     // least 50 asked; 144 measured over the 4 seeds). f32 output: 1e-6 relative.
-    let mat = Material::Dielectric(DielectricParams {
-        ior: 1.5,
-        ext_ior: 1.0,
-        roughness: Roughness::Isotropic(0.0),
-    });
-    let mut scene = sphere_scene(camera(4.0, 31.0, 160), mat, 1.0);
-    scene.settings.spp = 1;
-    scene.settings.max_depth = 15;
     let survivals = |s0: f64| (0..=10).find(|&k| (s0 * 0.95f64.powi(k) - 1.0).abs() < 1e-6);
     let mut deep = 0;
-    for seed in 0..4 {
-        scene.settings.seed = seed;
-        for p in run(&scene).stokes.pixels() {
-            let s0 = f64::from(p[0]);
-            let k = survivals(s0);
-            assert!(s0.abs() < 1e-6 || k.is_some(), "seed {seed}: S0 = {s0}");
-            deep += usize::from(k.is_some_and(|k| k > 0));
-        }
+    for v in glass_sphere_path_s0(31.0, 160, 15) {
+        let k = survivals(v);
+        assert!(v.abs() < 1e-6 || k.is_some(), "S0 = {v}");
+        deep += usize::from(k.is_some_and(|k| k > 0));
     }
     assert!(deep >= 50, "only {deep} paths survived a roulette");
 }
