@@ -37,12 +37,17 @@ impl Dielectric {
         if w.z > 0.0 { self.eta } else { 1.0 / self.eta }
     }
 
-    /// Probability of reflection given the reflected column `c_r` (unpolarized
-    /// input, output basis of `wo`): the other lobe's flux-unit column is
-    /// `e0 − c_r` for a lossless interface (`R + T = 1` per s and p, tested in polar-optics).
-    fn reflect_prob_of(&self, c_r: &Stokes) -> f64 {
+    /// Probability of reflection at (micro)normal `m` given the reflected column
+    /// `c_r` in its s/p frame (unpolarized input): `c_r,0`, or with a camera row
+    /// the choice of crate `lobe` on the column in the output basis of `wo`; the
+    /// other lobe's flux-unit column is `e0 − c_r` for a lossless interface
+    /// (`R + T = 1` per s and p, tested in polar-optics).
+    fn reflect_prob_of(&self, c_r: &Stokes, m: &V3, wo: &V3) -> f64 {
         match &self.importance {
-            Some(t) => first_lobe_probability(c_r[0], c_r, &(Stokes::x() - c_r), t),
+            Some(t) => {
+                let c = sp_column_to_wo_basis(c_r, m, wo);
+                first_lobe_probability(c[0], &c, &(Stokes::x() - c), t)
+            }
             None => c_r[0],
         }
     }
@@ -54,8 +59,10 @@ impl Dielectric {
         let etap = self.etap(wo);
         let wr = reflect_z(wo);
         let fresnel = fresnel_amplitudes(wo.z.abs(), etap.into());
-        let r_mueller = from_sp_frame(&fresnel.reflection_block(), &V3::z(), wo, &wr);
-        let r = self.reflect_prob_of(&r_mueller.column(0).into_owned());
+        // The choice needs column 0 only; the full reflection matrix is formed
+        // only when reflection is taken (glass transmits most paths).
+        let r = self.reflect_prob_of(&fresnel.reflected_unpolarized(), &V3::z(), wo);
+        let r_mueller = || from_sp_frame(&fresnel.reflection_block(), &V3::z(), wo, &wr);
         let n = V3::z() * wo.z.signum();
         match refract(wo, &n, etap) {
             Some(wt) if u >= r => {
@@ -71,8 +78,8 @@ impl Dielectric {
                     eta: etap,
                 })
             }
-            Some(_) => Some(BsdfSample::reflection(wr, r_mueller / r, r, true)),
-            None => Some(BsdfSample::reflection(wr, r_mueller, 1.0, true)),
+            Some(_) => Some(BsdfSample::reflection(wr, r_mueller() / r, r, true)),
+            None => Some(BsdfSample::reflection(wr, r_mueller(), 1.0, true)),
         }
     }
 
@@ -100,10 +107,7 @@ impl Dielectric {
     /// from the side of `wo` ([`Self::reflect_prob_of`] at the facet).
     fn reflect_prob(&self, wo: &V3, h: &V3) -> f64 {
         let c_r = fresnel_amplitudes(wo.dot(h).abs(), self.etap(wo).into()).reflected_unpolarized();
-        if self.importance.is_none() {
-            return c_r[0];
-        }
-        self.reflect_prob_of(&sp_column_to_wo_basis(&c_r, h, wo))
+        self.reflect_prob_of(&c_r, h, wo)
     }
 
     fn rough_eval(&self, ggx: &Ggx, wo: &V3, wi: &V3) -> Mueller {

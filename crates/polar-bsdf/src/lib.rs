@@ -168,6 +168,12 @@ impl Bsdf {
         }
     }
 
+    /// Whether this BSDF chooses between lobes, i.e. whether
+    /// [`Self::with_importance`] can change it (glass and plastic).
+    pub fn chooses_lobes(&self) -> bool {
+        matches!(self, Bsdf::Dielectric(_) | Bsdf::Plastic(_))
+    }
+
     /// Whether some lobe is a delta (then light sampling cannot reach that lobe).
     pub fn has_delta(&self) -> bool {
         self.model().has_delta()

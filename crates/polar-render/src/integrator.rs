@@ -223,11 +223,17 @@ impl Vertex<'_> {
         }
     }
 
+    /// A surface whose BSDF chooses between lobes (what [`Self::aim`] acts on).
+    fn chooses_lobes(&self) -> bool {
+        matches!(self, Vertex::Surface { bsdf, .. } if bsdf.chooses_lobes())
+    }
+
     /// Makes a surface's lobe choice follow what the camera measures, given the
     /// first row `t` of the throughput in the path frame and the rotation of
     /// this vertex's output basis into it: as a row, `t · rotator(θ)` is `t`
     /// rotated by `−θ` (see [`Bsdf::with_importance`]).
     fn aim(&mut self, t: &Stokes, (cos2, sin2): (f64, f64)) {
+        debug_assert!(self.chooses_lobes());
         if let Vertex::Surface { bsdf, wo, .. } = self {
             *bsdf = bsdf.with_importance(wo, &rotate_stokes(t, (cos2, -sin2)));
         }
@@ -369,6 +375,7 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
         };
         // An identity throughput (first vertex) sees unpolarized: the old choice.
         if R::MODEL != Polarization::None
+            && vertex.chooses_lobes()
             && let Some(t) = &throughput
         {
             vertex.aim(&t.first_row(), out_rotation);
