@@ -391,7 +391,9 @@ pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sam
         );
 
         // Continue the path by sampling the BSDF or the phase function.
-        let Some(s) = vertex.sample(sampler.next_scatter(depth, vertex.is_delta())) else {
+        let Some(s) =
+            vertex.sample(sampler.next_scatter(depth, vertex.chooses_lobes(), !vertex.is_delta()))
+        else {
             break;
         };
         let weight = to_path(&s.weight);

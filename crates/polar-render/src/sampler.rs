@@ -22,9 +22,18 @@
 //!
 //! Glass gains little (4 seeds: 1.08× at 64 spp, 1.13× at 256): its error comes from
 //! chains of reflect/refract choices, each in its own padded draw. (This table is for
-//! padded draws throughout; drawing the first bounce and the choices at delta vertices
-//! from the camera's Sobol point lowers the errors further, glass's most: see
-//! [`Sampler::next_scatter`].) The cost: a Sobol
+//! padded draws throughout.) The *path point* ([`Sampler::next_scatter`]) draws the
+//! first bounce, the first flight step in a medium and the choices of delta vertices
+//! jointly with the jitter. Relative RMSE at 256 / 1024 spp, padded → path point (the
+//! benchmark's references, tools/mitsuba/bench.py, one render each, 2 threads):
+//!
+//! | scene | S0 | polarization (S1, S2) |
+//! |---|---|---|
+//! | conductor | unchanged (nothing drawn at its vertex) | unchanged |
+//! | rough conductor | 0.147 / 0.055 → 0.124 / 0.034 % | 0.0096 / 0.0038 → 0.0081 / 0.0022 % |
+//! | pplastic | 0.175 / 0.070 → 0.139 / 0.052 % | 0.073 / 0.028 → 0.063 / 0.023 % |
+//! | glass | 0.109 / 0.054 → 0.106 / 0.057 % | 0.66 / 0.34 → 0.42 / 0.145 % |
+//! | haze | 7.3 / 3.6 → 3.1 / 1.5 % | 5.7 / 2.8 → 3.0 / 1.4 % | The cost: a Sobol
 //! draw takes about 340 instructions against about 30 for three hash numbers
 //! (`sobol_burley::sample_4d` emulates its 32-bit multiplies without SSE4.1, still
 //! fewer instructions than two scalar `sample` calls); per path sample that is +420
@@ -59,11 +68,6 @@ const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 const SEED_DOMAIN: u64 = 0x5b0b_5eed_0000_0000;
 const LOW_BITS_DOMAIN: u64 = 0x10e5_b175_0000_0000;
 const PATH_LOW_BITS_DOMAIN: u64 = 0x9a7b_b175_0000_0000;
-
-/// Dimensions of the path point (see [`Sampler::next_scatter`]) after the camera
-/// jitter's 0–1: the first vertex's lobe choice and 2-D point.
-const PATH_FIRST_CHOICE: u32 = 2;
-const PATH_FIRST_POINT: u32 = 3;
 
 /// `sobol_burley` supports sample indices below 2^16; each further block of 2^16
 /// samples gets its own scramble seed (an independent Owen-scrambled net).
@@ -105,6 +109,7 @@ impl PixelStreams {
             dimension: 0,
             draw: 0,
             path_set: None,
+            path_next: 0,
         }
     }
 }
@@ -124,6 +129,8 @@ pub struct Sampler {
     draw: u64,
     /// The last computed dimension set (4 dimensions) of the path point.
     path_set: Option<(u32, [f32; 4])>,
+    /// The path point's next unused dimension.
+    path_next: u32,
 }
 
 impl Sampler {
@@ -180,40 +187,46 @@ impl Sampler {
     }
 
     /// Aligned draw for sampling the BSDF (or phase function) of the vertex at path
-    /// depth `depth` (0: the camera ray's vertex), as [`Self::next_3d`] orders it.
-    /// `delta`: the vertex has only delta lobes, so it uses `u[0]` (its lobe choice) only.
+    /// depth `depth` (0: the camera ray's vertex), as [`Self::next_3d`] orders it:
+    /// `u[0]` chooses a lobe (used if `choice`), `(u[1], u[2])` samples a direction
+    /// (used if `point`; not by a vertex with only delta lobes).
     ///
-    /// With Sobol, the path's main dimensions are one point, not padded draws: the
-    /// camera jitter ([`Self::next_2d`], dimensions 0–1), the first vertex's lobe
-    /// choice (2) and 2-D point (3–4) are one 5-D Owen-scrambled Sobol point, and a
-    /// delta vertex at depth `k ≥ 1` takes its lobe choice from dimension `4 + k` of it. Where the
-    /// first bounce's direction and the chain of reflect/refract choices through glass
-    /// depend on the position in the pixel, this stratifies them jointly; padded draws
-    /// only stratify each draw by itself. Other vertices keep a padded 3-D draw, whose
-    /// choice and 2-D point are stratified together. Measured (1024 spp, polarization
-    /// error against padded draws): glass 0.34 → 0.16 %, rough conductor 0.0038 →
-    /// 0.0025 %, pplastic 0.028 → 0.023 %; see the table in the module documentation.
-    pub fn next_scatter(&mut self, depth: u32, delta: bool) -> [f64; 3] {
-        // Depth k ≥ 1 chooses with dimension 4 + k (5, 6, ...).
-        let choice = if depth == 0 {
-            PATH_FIRST_CHOICE
-        } else {
-            PATH_FIRST_POINT + 1 + depth
-        };
+    /// With Sobol, the numbers that matter most come from one point, the *path point*,
+    /// in the order the path uses them: the camera jitter ([`Self::next_2d`]), each
+    /// flight's first number in a medium ([`Self::next_flight`]), the first vertex's
+    /// choice and direction, and the choices of the delta vertices after it (glass).
+    /// Where the first bounce, the distance to the first scattering in a medium and
+    /// the chain of reflect/refract choices depend on the position in the pixel, this
+    /// stratifies them jointly; padded draws only stratify each draw by itself. Other
+    /// vertices keep a padded 3-D draw, whose choice and 2-D point are stratified
+    /// together. Numbers not used are free ones. Measured: see the module documentation.
+    pub fn next_scatter(&mut self, depth: u32, choice: bool, point: bool) -> [f64; 3] {
+        if self.kind == SamplerKind::Independent || (depth > 0 && point) {
+            return self.next_3d();
+        }
+        self.draw += 1;
+        let u0 = self.path_or_free(choice);
+        let [u1, u2] = [(); 2].map(|()| self.path_or_free(point));
+        [u0, u1, u2]
+    }
+
+    /// The number for the first free-flight step of a ray in a medium: the path
+    /// point's next dimension with Sobol (see [`Self::next_scatter`]), else a free
+    /// number. Further steps, in data-dependent counts, take free numbers.
+    pub fn next_flight(&mut self) -> f64 {
         match self.kind {
-            SamplerKind::Sobol if depth == 0 => {
-                self.draw += 1;
-                // In order of dimension: set 0 (cached by the camera draw), then set 1.
-                let u0 = self.path_dim(choice);
-                let point = [PATH_FIRST_POINT, PATH_FIRST_POINT + 1].map(|d| self.path_dim(d));
-                [u0, point[0], point[1]]
-            }
-            SamplerKind::Sobol if delta && choice < sobol_burley::NUM_DIMENSIONS => {
-                self.draw += 1;
-                // Unused by a delta vertex; independent numbers all the same.
-                [self.path_dim(choice), self.next_free(), self.next_free()]
-            }
-            _ => self.next_3d(),
+            SamplerKind::Sobol => self.path_or_free(true),
+            SamplerKind::Independent => self.next_free(),
+        }
+    }
+
+    /// The path point's next dimension if `used` (and not past its last), else a free number.
+    fn path_or_free(&mut self, used: bool) -> f64 {
+        if used && self.path_next < sobol_burley::NUM_DIMENSIONS {
+            self.path_next += 1;
+            self.path_dim(self.path_next - 1)
+        } else {
+            self.next_free()
         }
     }
 
@@ -259,8 +272,9 @@ impl Sampler {
     fn sobol<const N: usize>(&mut self) -> [f64; N] {
         let x = sobol_burley::sample_4d(self.index(), 0, self.seed(self.draw));
         if self.draw == 0 {
-            // The camera draw is the path point's first set (see `path_dim`).
+            // The camera draw is the path point's first set and dimensions (see `path_dim`).
             self.path_set = Some((0, x));
+            self.path_next = N as u32;
         }
         let low_key = self.key ^ LOW_BITS_DOMAIN ^ (4 * self.draw).wrapping_mul(GAMMA);
         self.draw += 1;
@@ -440,53 +454,68 @@ mod tests {
             .unwrap_or(m)
     }
 
-    /// Camera jitter and one coordinate of the scatter draw at `depth`, for 2^m samples
-    /// of one pixel (lights drawn before the scatter draw, as the integrator does).
-    fn jitter_and_scatter(depth: u32, delta: bool, coord: usize, m: u32) -> Vec<[f64; 2]> {
+    /// Camera jitter and one number of each of 2^m samples of one pixel, drawn by
+    /// `draw` after the camera draw.
+    fn jitter_and(m: u32, draw: impl Fn(&mut Sampler) -> f64) -> Vec<[f64; 2]> {
         let streams = PixelStreams::new(5, 77, SamplerKind::Sobol);
         (0..1u64 << m)
             .map(|i| {
                 let mut s = streams.sample(i);
-                let [jx, _] = s.next_2d();
-                for d in 0..=depth {
-                    s.next_3d();
-                    let u = s.next_scatter(d, delta);
-                    if d == depth {
-                        return [jx, u[coord]];
-                    }
-                }
-                unreachable!()
+                [s.next_2d()[0], draw(&mut s)]
             })
             .collect()
     }
 
+    /// Coordinate `coord` of the scatter draw at `depth` after light draws and delta
+    /// vertices (a choice each) at the depths before, as the integrator draws them.
+    fn scatter_at(s: &mut Sampler, depth: u32, choice: bool, point: bool, coord: usize) -> f64 {
+        for d in 0..depth {
+            s.next_3d();
+            s.next_scatter(d, true, false);
+        }
+        s.next_3d();
+        s.next_scatter(depth, choice, point)[coord]
+    }
+
     #[test]
-    fn the_first_bounce_and_delta_choices_are_stratified_with_the_pixel() {
-        // 1024 samples. Joint with the jitter (one Sobol point): the first vertex's
-        // choice and 2-D point, and the choices of delta vertices deeper down, are
-        // (t,10,2)-nets with small t. Padded (non-delta vertices deeper down): only as
-        // random pairs are, t = 6 or more (the test can fail).
+    fn the_path_point_is_stratified_with_the_pixel_and_padded_draws_are_not() {
+        // 1024 samples. From the path point, jointly with the jitter: a flight, the
+        // first vertex's choice and direction, the choices of delta vertices deeper
+        // down: (t,10,2)-nets with small t (measured 0-2). Padded draws (vertices
+        // after the first that sample a direction): only as random pairs are,
+        // t = 6 or more (measured 9).
         let m = 10;
-        for coord in 0..3 {
-            let t = t_value(&jitter_and_scatter(0, false, coord, m));
-            assert!(t <= 2, "first vertex, u[{coord}]: t = {t}");
+        let t = t_value(&jitter_and(m, |s| s.next_flight()));
+        assert!(t <= 2, "flight: t = {t}");
+        for (choice, coords) in [(true, 0..3), (false, 1..3)] {
+            for coord in coords {
+                let t = t_value(&jitter_and(m, |s| scatter_at(s, 0, choice, true, coord)));
+                assert!(
+                    t <= 3,
+                    "first vertex (choice {choice}), u[{coord}]: t = {t}"
+                );
+            }
         }
         for depth in 1..4 {
-            let t = t_value(&jitter_and_scatter(depth, true, 0, m));
+            let t = t_value(&jitter_and(m, |s| scatter_at(s, depth, true, false, 0)));
             assert!(t <= 3, "delta vertex at depth {depth}: t = {t}");
-            let t = t_value(&jitter_and_scatter(depth, false, 0, m));
-            assert!(t >= 6, "smooth vertex at depth {depth}: t = {t}");
+            let t = t_value(&jitter_and(m, |s| scatter_at(s, depth, true, true, 1)));
+            assert!(
+                t >= 6,
+                "vertex sampling a direction at depth {depth}: t = {t}"
+            );
         }
     }
 
     #[test]
-    fn scatter_draws_of_the_independent_sampler_are_plain_draws() {
-        for (depth, delta) in [(0, false), (1, true), (2, false)] {
+    fn the_independent_sampler_has_no_path_point() {
+        for (depth, choice, point) in [(0, true, true), (1, true, false), (2, false, true)] {
             let (mut a, mut b) = (
                 Sampler::new(1, 2, 3, SamplerKind::Independent),
                 Sampler::new(1, 2, 3, SamplerKind::Independent),
             );
-            assert_eq!(a.next_scatter(depth, delta), b.next_3d());
+            assert_eq!(a.next_scatter(depth, choice, point), b.next_3d());
+            assert_eq!(a.next_flight(), b.next_free());
         }
     }
 

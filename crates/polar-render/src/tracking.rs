@@ -39,10 +39,11 @@ pub(crate) fn clip(m: &Medium, o: &Vec3, d: &Vec3, t_max: f64) -> Option<(f64, f
     (t0 < t1).then_some((t0, t1))
 }
 
-/// An exponential step of rate `rate` (`rate > 0`). Tracking draws its numbers in
-/// data-dependent counts, so from the sampler's free stream.
-fn step(rate: f64, sampler: &mut Sampler) -> f64 {
-    -(1.0 - sampler.next_free()).ln() / rate
+/// An exponential step of rate `rate` (`rate > 0`) for the uniform number `u`.
+/// Tracking draws its numbers in data-dependent counts, so from the sampler's free
+/// stream, except a flight's first step (see [`Sampler::next_flight`]).
+fn step(rate: f64, u: f64) -> f64 {
+    -(1.0 - u).ln() / rate
 }
 
 /// Samples the first scattering event along `o + t d`, `t < t_max`. Homogeneous:
@@ -69,9 +70,8 @@ pub(crate) fn flight<'a>(
     if majorant == 0.0 {
         return Flight::Pass { weight: 1.0 };
     }
-    let mut t = t0;
+    let mut t = t0 + step(majorant, sampler.next_flight());
     loop {
-        t += step(majorant, sampler);
         if t >= t1 {
             return Flight::Pass { weight: 1.0 };
         }
@@ -87,6 +87,7 @@ pub(crate) fn flight<'a>(
                 medium: m,
             };
         }
+        t += step(majorant, sampler.next_free());
     }
 }
 
@@ -111,7 +112,7 @@ pub(crate) fn transmittance(
     }
     let (mut t, mut tr) = (t0, 1.0);
     loop {
-        t += step(majorant, sampler);
+        t += step(majorant, sampler.next_free());
         if t >= t1 {
             return tr;
         }
