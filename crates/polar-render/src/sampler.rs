@@ -220,9 +220,14 @@ impl Sampler {
         }
     }
 
-    /// The path point's next dimension if `used` (and not past its last), else a free number.
+    /// The path point's next dimension if `used` (past its last, a free number).
+    /// A number not used is a free one that is skipped, not computed (NaN: a BSDF
+    /// reading it would show; polar-bsdf's tests/sample_reads.rs checks that none does).
     fn path_or_free(&mut self, used: bool) -> f64 {
-        if used && self.path_next < sobol_burley::NUM_DIMENSIONS {
+        if !used {
+            self.dimension += 1;
+            f64::NAN
+        } else if self.path_next < sobol_burley::NUM_DIMENSIONS {
             self.path_next += 1;
             self.path_dim(self.path_next - 1)
         } else {
