@@ -20,6 +20,7 @@ pub struct Conductor {
 /// Microfacet reflection `F(h) D(h) G / (4 cos θo)` (that is `f cos θi`) about
 /// the half vector `h`, for the relative index `eta`; zero unless both
 /// directions are above the surface.
+#[inline(always)]
 pub(crate) fn microfacet_reflection(ggx: &Ggx, eta: Complex64, wo: &V3, wi: &V3) -> Mueller {
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return Mueller::zeros();
@@ -31,6 +32,7 @@ pub(crate) fn microfacet_reflection(ggx: &Ggx, eta: Complex64, wo: &V3, wi: &V3)
 
 /// Density of `wi` when a visible normal `h` is sampled from `wo` and `wo` is
 /// mirrored about it: `D_wo(h) / (4 wo·h)`.
+#[inline(always)]
 pub(crate) fn microfacet_reflection_pdf(ggx: &Ggx, wo: &V3, wi: &V3) -> f64 {
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return 0.0;
@@ -40,6 +42,7 @@ pub(crate) fn microfacet_reflection_pdf(ggx: &Ggx, wo: &V3, wi: &V3) -> f64 {
 }
 
 impl Model for Conductor {
+    #[inline(always)]
     fn eval(&self, wo: &V3, wi: &V3) -> Mueller {
         match &self.roughness {
             Some(ggx) => microfacet_reflection(ggx, self.eta, wo, wi),
@@ -47,12 +50,14 @@ impl Model for Conductor {
         }
     }
 
+    #[inline(always)]
     fn pdf(&self, wo: &V3, wi: &V3) -> f64 {
         self.roughness
             .as_ref()
             .map_or(0.0, |ggx| microfacet_reflection_pdf(ggx, wo, wi))
     }
 
+    #[inline(always)]
     fn sample(&self, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;

@@ -42,6 +42,7 @@ impl Dielectric {
     /// the choice of crate `lobe` on the column in the output basis of `wo`; the
     /// other lobe's flux-unit column is `e0 − c_r` for a lossless interface
     /// (`R + T = 1` per s and p, tested in polar-optics).
+    #[inline(always)]
     fn reflect_prob_of(&self, c_r: &Stokes, m: &V3, wo: &V3) -> f64 {
         match &self.importance {
             Some(t) => {
@@ -55,6 +56,7 @@ impl Dielectric {
     /// One Fresnel evaluation serves both lobes: the flux-unit transmission
     /// matrix in the s/p frame is the same from either side (Stokes relations;
     /// tested in polar-optics), so that of light leaving along `wo` is used.
+    #[inline(always)]
     fn smooth_sample(&self, wo: &V3, u: f64) -> Option<BsdfSample> {
         let etap = self.etap(wo);
         let wr = reflect_z(wo);
@@ -171,18 +173,21 @@ impl Dielectric {
 }
 
 impl Model for Dielectric {
+    #[inline(always)]
     fn eval(&self, wo: &V3, wi: &V3) -> Mueller {
         self.roughness
             .as_ref()
             .map_or_else(Mueller::zeros, |ggx| self.rough_eval(ggx, wo, wi))
     }
 
+    #[inline(always)]
     fn pdf(&self, wo: &V3, wi: &V3) -> f64 {
         self.roughness
             .as_ref()
             .map_or(0.0, |ggx| self.rough_pdf(ggx, wo, wi))
     }
 
+    #[inline(always)]
     fn sample(&self, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
         if wo.z == 0.0 {
             return None;

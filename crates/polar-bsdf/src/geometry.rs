@@ -15,6 +15,7 @@ pub(crate) type V3 = Vector3<f64>;
 const DEGENERATE_SQ: f64 = 1e-24;
 
 /// Mirror direction of `w` about the unit normal `m`: `2 (w·m) m − w`.
+#[inline(always)]
 pub(crate) fn reflect(w: &V3, m: &V3) -> V3 {
     2.0 * w.dot(m) * m - w
 }
@@ -27,6 +28,7 @@ pub(crate) fn reflect_z(w: &V3) -> V3 {
 /// Refraction of `w` (pointing away from the surface, `w·m > 0`) through the
 /// interface with normal `m`, where `etap = n_other / n_w` (Snell). `None` under
 /// total internal reflection.
+#[inline(always)]
 pub(crate) fn refract(w: &V3, m: &V3, etap: f64) -> Option<V3> {
     let cos_w = w.dot(m);
     let sin2_t = (1.0 - cos_w * cos_w).max(0.0) / (etap * etap);
@@ -61,6 +63,7 @@ pub(crate) fn cosine_hemisphere_pdf(w: &V3) -> f64 {
 /// invariant to the length of its axes: a square root and a division saved);
 /// any axis perpendicular to `k` when they are collinear (normal incidence,
 /// where the Fresnel matrix is isotropic).
+#[inline(always)]
 pub(crate) fn s_axis(normal: &V3, k: &V3) -> V3 {
     let c = normal.cross(k);
     if c.norm_squared() > DEGENERATE_SQ {
@@ -74,7 +77,7 @@ pub(crate) fn s_axis(normal: &V3, k: &V3) -> V3 {
 /// along `k_in`) and output x axis `s_out` (light along `k_out`) into the
 /// interface's bases `stokes_basis(k_in)` and `stokes_basis(k_out)`, as
 /// `(cos 2θ, sin 2θ)`: `(output, input)` for `rotator(output) · M · rotator(input)`.
-#[inline]
+#[inline(always)]
 fn bsdf_rotations(k_in: &V3, s_in: &V3, k_out: &V3, s_out: &V3) -> ((f64, f64), (f64, f64)) {
     (
         double_angle(k_out, s_out, &stokes_basis(k_out)),
@@ -94,6 +97,7 @@ pub(crate) fn to_bsdf_bases(m: &Mueller, k_in: &V3, s_in: &V3, k_out: &V3, s_out
 /// between two polarizing ones): rotating the two vectors instead of the product's
 /// rows and columns takes 8 multiplications instead of 32. The row is a column
 /// rotated by `−θ`: `(rowᵀ · R(θ))ᵀ = R(−θ) · row`.
+#[inline(always)]
 pub(crate) fn rank_one_to_bsdf_bases(
     col: &Stokes,
     row: &Stokes,
@@ -109,6 +113,7 @@ pub(crate) fn rank_one_to_bsdf_bases(
 /// Fresnel reflection at the (micro)normal `m` of light arriving along `-wi` and
 /// leaving along `wo`, for relative index `eta = n_transmitted / n_incident`
 /// (complex for conductors), in the BSDF bases.
+#[inline(always)]
 pub(crate) fn reflection(eta: num_complex::Complex64, m: &V3, wo: &V3, wi: &V3) -> Mueller {
     let f = fresnel_amplitudes(wi.dot(m).abs(), eta).reflection_block();
     from_sp_frame(&f, m, wo, wi)
@@ -118,7 +123,7 @@ pub(crate) fn reflection(eta: num_complex::Complex64, m: &V3, wo: &V3, wi: &V3) 
 /// of incidence at the (micro)normal `m` (light arriving along `-wi`, leaving
 /// along `wo`; x = s on both sides) in the BSDF bases, without forming `f` as 4×4.
 /// Inlined into the BSDFs: as a call, the smooth dielectric scene rendered 3% slower.
-#[inline]
+#[inline(always)]
 pub(crate) fn from_sp_frame(f: &BlockDiagonal, m: &V3, wo: &V3, wi: &V3) -> Mueller {
     let k_in = -wi;
     let s = s_axis(m, &k_in);
@@ -129,6 +134,7 @@ pub(crate) fn from_sp_frame(f: &BlockDiagonal, m: &V3, wo: &V3, wi: &V3) -> Muel
 /// Column 0 of [`from_sp_frame`] (light leaving along `wo`, any `wi` in the
 /// plane of `m` and `wo`) from column 0 `c` in the s/p frame at `m`: the output
 /// of the interface for unpolarized input, which only needs the output rotation.
+#[inline(always)]
 pub(crate) fn sp_column_to_wo_basis(c: &Stokes, m: &V3, wo: &V3) -> Stokes {
     rotate_stokes(c, double_angle(wo, &s_axis(m, wo), &stokes_basis(wo)))
 }

@@ -14,6 +14,7 @@ pub struct Lambertian {
 }
 
 impl Model for Lambertian {
+    #[inline(always)]
     fn eval(&self, wo: &V3, wi: &V3) -> Mueller {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Mueller::zeros();
@@ -29,6 +30,7 @@ impl Model for Lambertian {
         }
     }
 
+    #[inline(always)]
     fn sample(&self, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
         let wi = cosine_hemisphere([u[1], u[2]]);
         if wo.z <= 0.0 || wi.z <= 0.0 {

@@ -2,6 +2,11 @@
 //! instead of spectra, following Mitsuba 3's recipe (Fresnel matrix in the s/p
 //! frame, then rotated into the implicit Stokes bases of the two directions).
 //!
+//! Functions on the renderer's per-sample path are `#[inline(always)]` (and [`Bsdf`]
+//! dispatches to its models by `match`, not `&dyn`): `polar-render` compiles its
+//! sample loop once per SIMD target, and only code inlined into it gets the
+//! target's instructions (`polar-render`'s `render.rs`, `TileOp`).
+//!
 //! # Interface contract (shared with `polar-render`)
 //! - Directions are unit vectors in the local shading frame: `z` = shading
 //!   normal, `x` = tangent (anisotropy and sheet axis), `y = z × x`.
@@ -121,31 +126,39 @@ trait Model {
     fn polarization(&self) -> Polarization;
 }
 
-impl Bsdf {
-    fn model(&self) -> &dyn Model {
-        match self {
-            Bsdf::Lambertian(b) => b,
-            Bsdf::Conductor(b) => b,
-            Bsdf::Dielectric(b) => b,
-            Bsdf::Plastic(b) => b,
-            Bsdf::Sheet(b) => b,
+/// `$call` on the model inside the [`Bsdf`] `$bsdf`, bound to `$m`: a `match` (static
+/// dispatch, so each model's method can be inlined into a caller, which a call
+/// through `&dyn Model` prevents).
+macro_rules! with_model {
+    ($bsdf:expr, $m:ident => $call:expr) => {
+        match $bsdf {
+            Bsdf::Lambertian($m) => $call,
+            Bsdf::Conductor($m) => $call,
+            Bsdf::Dielectric($m) => $call,
+            Bsdf::Plastic($m) => $call,
+            Bsdf::Sheet($m) => $call,
         }
-    }
+    };
+}
 
+impl Bsdf {
     /// `f(wo, wi) |cos θi|` as a Mueller matrix (zero for delta lobes).
+    #[inline(always)]
     pub fn eval(&self, wo: &Vector3<f64>, wi: &Vector3<f64>) -> Mueller {
-        self.model().eval(wo, wi)
+        with_model!(self, m => m.eval(wo, wi))
     }
 
     /// Solid-angle density with which [`Self::sample`] returns `wi` (0 for delta lobes).
+    #[inline(always)]
     pub fn pdf(&self, wo: &Vector3<f64>, wi: &Vector3<f64>) -> f64 {
-        self.model().pdf(wo, wi)
+        with_model!(self, m => m.pdf(wo, wi))
     }
 
     /// Samples `wi` given `wo` and three uniform numbers in `[0, 1)` (the first
     /// picks a lobe where there are several). `None` when no light can arrive.
+    #[inline(always)]
     pub fn sample(&self, wo: &Vector3<f64>, u: [f64; 3]) -> Option<BsdfSample> {
-        self.model().sample(wo, u)
+        with_model!(self, m => m.sample(wo, u))
     }
 
     /// This BSDF with its lobe choice made for what the camera measures: `t` is
@@ -176,7 +189,7 @@ impl Bsdf {
 
     /// Whether some lobe is a delta (then light sampling cannot reach that lobe).
     pub fn has_delta(&self) -> bool {
-        self.model().has_delta()
+        with_model!(self, m => m.has_delta())
     }
 
     /// Whether every lobe is a delta (smooth conductor or dielectric, sheets): then
@@ -190,6 +203,6 @@ impl Bsdf {
 
     /// The cheapest exact transport model this BSDF needs.
     pub fn polarization(&self) -> Polarization {
-        self.model().polarization()
+        with_model!(self, m => m.polarization())
     }
 }

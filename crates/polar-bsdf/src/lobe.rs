@@ -29,6 +29,7 @@ const FLOOR: f64 = 1e-6;
 /// `c_second` for unpolarized input, and the camera row `t` (module doc).
 /// Falls back to `p_first` when `t_0 ≤ 0` (nothing reaches the camera) or a
 /// lobe's `c_0` vanishes where the old choice still picks it.
+#[inline(always)]
 pub(crate) fn first_lobe_probability(
     p_first: f64,
     c_first: &Stokes,

@@ -393,6 +393,7 @@ impl Material {
     }
 
     /// The BSDF at surface coordinates `uv` (call [`Self::validate`] once first).
+    #[inline(always)]
     pub fn bsdf(&self, uv: [f64; 2]) -> Bsdf {
         match self {
             Material::Lambertian(p) => Bsdf::Lambertian(Lambertian {

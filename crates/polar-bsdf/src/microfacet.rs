@@ -46,6 +46,7 @@ impl Ggx {
 
     /// Smith masking `G1(v, m) = 1 / (1 + Λ(v))`, 0 unless `v` sees the front of
     /// `m` from the same side as the macro surface (`(v·m)(v·z) > 0`).
+    #[inline(always)]
     pub fn g1(&self, v: &V3, m: &V3) -> f64 {
         if v.dot(m) * v.z <= 0.0 {
             return 0.0;
@@ -54,12 +55,14 @@ impl Ggx {
     }
 
     /// Separable masking–shadowing `G1(wo, m) G1(wi, m)`.
+    #[inline(always)]
     pub fn g(&self, wo: &V3, wi: &V3, m: &V3) -> f64 {
         self.g1(wo, m) * self.g1(wi, m)
     }
 
     /// A microfacet normal (with `mz > 0`) drawn from the visible normals seen
     /// from `v` (or from `-v` when `v` lies below the surface), Heitz 2018.
+    #[inline(always)]
     pub fn sample_visible(&self, v: &V3, u: [f64; 2]) -> V3 {
         let v = if v.z < 0.0 { -v } else { *v };
         let vh = V3::new(self.alpha_x * v.x, self.alpha_y * v.y, v.z).normalize();
@@ -81,6 +84,7 @@ impl Ggx {
 
     /// Density of [`Self::sample_visible`] over microfacet normals:
     /// `G1(v, m) |v·m| D(m) / |vz|`.
+    #[inline(always)]
     pub fn pdf_visible(&self, v: &V3, m: &V3) -> f64 {
         if v.z == 0.0 {
             return 0.0;

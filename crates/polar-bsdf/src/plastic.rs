@@ -43,6 +43,7 @@ pub struct Plastic {
 
 impl Plastic {
     /// The diffuse lobe `T_out(θo) · D · T_in(θi) · albedo cos θi / π`, in the BSDF bases.
+    #[inline(always)]
     fn diffuse(&self, wo: &V3, wi: &V3) -> Mueller {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Mueller::zeros();
@@ -62,6 +63,7 @@ impl Plastic {
 
     /// Column 0 of `T_out(θo)` in the s/p frame: unpolarized light from inside
     /// (the internal direction that refracts out along `wo`) leaving along `wo`.
+    #[inline(always)]
     fn exit_transmission(&self, wo: &V3) -> Stokes {
         let cos_inside = (1.0 - (1.0 - wo.z * wo.z) / (self.eta * self.eta))
             .max(0.0)
@@ -94,6 +96,7 @@ impl Plastic {
 }
 
 impl Model for Plastic {
+    #[inline(always)]
     fn eval(&self, wo: &V3, wi: &V3) -> Mueller {
         let diffuse = self.diffuse(wo, wi);
         match &self.roughness {
@@ -102,6 +105,7 @@ impl Model for Plastic {
         }
     }
 
+    #[inline(always)]
     fn pdf(&self, wo: &V3, wi: &V3) -> f64 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
@@ -113,6 +117,7 @@ impl Model for Plastic {
         self.specular_prob * specular + self.diffuse_prob() * cosine_hemisphere_pdf(wi)
     }
 
+    #[inline(always)]
     fn sample(&self, wo: &V3, u: [f64; 3]) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;

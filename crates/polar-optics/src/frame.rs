@@ -126,7 +126,7 @@ pub fn scattering_axis(k_in: &Vector3<f64>, k_out: &Vector3<f64>) -> Vector3<f64
 /// [`scattering_axis`] for both beams) in the implicit frames: input in
 /// `stokes_basis(k_in)`, output in `stokes_basis(k_out)`. The one place every phase
 /// matrix goes through.
-#[inline]
+#[inline(always)]
 pub fn from_scattering_plane(m: &Mueller, k_in: &Vector3<f64>, k_out: &Vector3<f64>) -> Mueller {
     let s = scattering_axis(k_in, k_out);
     rotate_mueller_basis(

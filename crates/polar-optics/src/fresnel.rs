@@ -48,7 +48,7 @@ pub struct FresnelAmplitudes {
 ///
 /// Inlined across crates (BSDF sampling's hot path): a caller that keeps only
 /// the reflection amplitudes then skips the transmission ones.
-#[inline]
+#[inline(always)]
 pub fn fresnel_amplitudes(cos_i: f64, eta: Complex64) -> FresnelAmplitudes {
     let zero = Complex64::new(0.0, 0.0);
     let one = Complex64::new(1.0, 0.0);
@@ -117,7 +117,7 @@ fn real_amplitudes(cos_i: f64, eta: f64, sin2_i: f64) -> FresnelAmplitudes {
 
 /// [`fresnel_amplitudes`] in complex arithmetic (conductors, total internal reflection,
 /// grazing incidence) for `cos_i` in `[0, 1]` and `sin2_i = 1 − cos_i²`.
-#[inline]
+#[inline(always)]
 fn complex_amplitudes(cos_i: f64, eta: Complex64, sin2_i: f64) -> FresnelAmplitudes {
     let zero = Complex64::new(0.0, 0.0);
     let one = Complex64::new(1.0, 0.0);
@@ -198,12 +198,14 @@ const PERFECT_CONDUCTOR: f64 = 1e30;
 
 impl FresnelAmplitudes {
     /// Power reflectances `(R_s, R_p)`.
+    #[inline(always)]
     pub fn reflectance(&self) -> (f64, f64) {
         (self.r_s.norm_sqr(), self.r_p.norm_sqr())
     }
 
     /// Power transmittances `(T_s, T_p) = Re(η cos θt)/cos θi · |t|²` (energy flux
     /// across the interface, real `η` only); 0 at grazing incidence and under TIR.
+    #[inline(always)]
     pub fn transmittance(&self) -> (f64, f64) {
         let f = self.flux_factor();
         (f * self.t_s.norm_sqr(), f * self.t_p.norm_sqr())
@@ -231,6 +233,7 @@ impl FresnelAmplitudes {
 
     /// First column of [`Self::reflection_mueller`], unpolarized unit light
     /// reflected: `((R_s + R_p)/2, (R_s − R_p)/2, 0, 0)` (what a lobe choice needs).
+    #[inline(always)]
     pub fn reflected_unpolarized(&self) -> Stokes {
         let (r_s, r_p) = self.reflectance();
         Stokes::new(0.5 * (r_s + r_p), 0.5 * (r_s - r_p), 0.0, 0.0)
@@ -254,6 +257,7 @@ impl FresnelAmplitudes {
     /// transmitted: `((T_s + T_p)/2, (T_s − T_p)/2, 0, 0)`. It is also the first row
     /// (the matrix is symmetric), so it is all a depolarizing lobe between two
     /// refractions needs, without the `S2, S3` block.
+    #[inline(always)]
     pub fn transmitted_unpolarized(&self) -> Stokes {
         let (t_s, t_p) = self.transmittance();
         Stokes::new(0.5 * (t_s + t_p), 0.5 * (t_s - t_p), 0.0, 0.0)

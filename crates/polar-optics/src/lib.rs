@@ -5,6 +5,10 @@
 //! ([`scatter`]: Rayleigh, Henyey–Greenstein with depolarization, Mie spheres) and a
 //! single-scattering Rayleigh sky ([`sky`]).
 //!
+//! The Fresnel and phase-function code the renderer runs per sample is
+//! `#[inline(always)]`, so that it is compiled into each SIMD version of the
+//! renderer's sample loop (`polar-render`).
+//!
 //! Conventions (see the project README, "Conventions"):
 //! - A Stokes vector is expressed in a reference frame `(x, y)` perpendicular to
 //!   the propagation direction `k` with `x × y = k` (right-handed w.r.t. the light).

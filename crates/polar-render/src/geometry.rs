@@ -87,6 +87,7 @@ impl Primitive {
     }
 
     /// Nearest intersection in `(tmin, tmax)` as `(t, b1, b2)` (barycentrics for triangles).
+    #[inline(always)]
     pub fn intersect(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<(f64, f64, f64)> {
         match self {
             Primitive::Triangle { p, .. } => {
@@ -229,6 +230,7 @@ impl Accel {
     }
 
     /// Closest primitive hit along the unit direction `d` in `(tmin, tmax)`: `(primitive, t, b1, b2)`.
+    #[inline(always)]
     pub fn closest(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
         let Some(bvh) = &self.bvh else {
             return self.closest_brute_force(o, d, tmin, tmax);
@@ -256,6 +258,7 @@ impl Accel {
     }
 
     /// [`Self::closest`] by testing every primitive (small scenes).
+    #[inline(always)]
     fn closest_brute_force(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
         let mut best: Option<PrimHit> = None;
         for (prim, p) in self.prims.iter().enumerate() {
@@ -268,6 +271,7 @@ impl Accel {
     }
 
     /// `true` when nothing blocks the segment from `o` along `d` over `(tmin, tmax)`.
+    #[inline(always)]
     pub fn unoccluded(&self, o: &Vec3, d: &Vec3, tmin: f64, tmax: f64) -> bool {
         let Some(bvh) = &self.bvh else {
             return self
@@ -283,6 +287,7 @@ impl Accel {
     }
 
     /// Full surface data of a hit on primitive `prim`.
+    #[inline(always)]
     pub fn surface(&self, scene: &Scene, hit: PrimHit, o: &Vec3, d: &Vec3) -> SurfaceHit {
         let PrimHit { prim, t, b1, b2 } = hit;
         let p = o + t * d;

@@ -172,6 +172,7 @@ impl Vertex<'_> {
 
     /// The Mueller matrix for light from `wi` (input basis [`Self::in_x`]), its
     /// sampling density and the input basis x axis.
+    #[inline(always)]
     fn eval(&self, wi: &Vec3) -> (Mueller, f64, Vec3) {
         match self {
             Vertex::Surface {
@@ -252,6 +253,7 @@ impl Vertex<'_> {
 /// against the vertex's own sampling), each attenuated by the medium. Delta
 /// vertices skip the light's random numbers, so the streams do not depend on it.
 /// `to_path` takes a matrix of this vertex into the path frame.
+#[inline(always)]
 fn next_event<R: Transport>(
     world: &World,
     vertex: &Vertex,
@@ -308,6 +310,7 @@ fn add<R: Transport>(sum: &mut Stokes, t: Option<&R>, le: &R::Stokes, w: f64) {
 /// computed when something polarized or a vertex needs it (a primary ray that
 /// sees an unpolarized environment never does), and the throughput is `None`
 /// while it is the identity (products with it are copies).
+#[inline(always)]
 pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sampler) -> Stokes {
     let settings = &world.scene.settings;
     let (mut o, mut d) = (world.camera.position, *d0);

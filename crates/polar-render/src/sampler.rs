@@ -157,6 +157,7 @@ impl Sampler {
     }
 
     /// Aligned draw of a 2-D point in `[0, 1)²` (Sobol dimensions 0 and 1).
+    #[inline(always)]
     pub fn next_2d(&mut self) -> [f64; 2] {
         match self.kind {
             SamplerKind::Sobol => self.sobol::<2>(),
@@ -167,6 +168,7 @@ impl Sampler {
     /// Aligned draw of three numbers for "choose, then sample a 2-D point":
     /// `u[0]` is Sobol dimension 2, `(u[1], u[2])` dimensions 0 and 1, a
     /// (0,2)-sequence, as the BSDFs and lights use them.
+    #[inline(always)]
     pub fn next_3d(&mut self) -> [f64; 3] {
         match self.kind {
             SamplerKind::Sobol => {
@@ -200,19 +202,21 @@ impl Sampler {
     /// stratifies them jointly; padded draws only stratify each draw by itself. Other
     /// vertices keep a padded 3-D draw, whose choice and 2-D point are stratified
     /// together. Numbers not used are free ones. Measured: see the module documentation.
+    #[inline(always)]
     pub fn next_scatter(&mut self, depth: u32, choice: bool, point: bool) -> [f64; 3] {
         if self.kind == SamplerKind::Independent || (depth > 0 && point) {
             return self.next_3d();
         }
         self.draw += 1;
         let u0 = self.path_or_free(choice);
-        let [u1, u2] = [(); 2].map(|()| self.path_or_free(point));
-        [u0, u1, u2]
+        let u1 = self.path_or_free(point);
+        [u0, u1, self.path_or_free(point)]
     }
 
     /// The number for the first free-flight step of a ray in a medium: the path
     /// point's next dimension with Sobol (see [`Self::next_scatter`]), else a free
     /// number. Further steps, in data-dependent counts, take free numbers.
+    #[inline(always)]
     pub fn next_flight(&mut self) -> f64 {
         match self.kind {
             SamplerKind::Sobol => self.path_or_free(true),
@@ -223,6 +227,7 @@ impl Sampler {
     /// The path point's next dimension if `used` (past its last, a free number).
     /// A number not used is a free one that is skipped, not computed (NaN: a BSDF
     /// reading it would show; polar-bsdf's tests/sample_reads.rs checks that none does).
+    #[inline(always)]
     fn path_or_free(&mut self, used: bool) -> f64 {
         if !used {
             self.dimension += 1;
@@ -237,6 +242,7 @@ impl Sampler {
 
     /// Dimension `dim` of this sample's path point: the Sobol point of the camera
     /// draw (draw 0, whose scramble seed it shares), continued to higher dimensions.
+    #[inline(always)]
     fn path_dim(&mut self, dim: u32) -> f64 {
         let set = dim / 4;
         let x = match self.path_set {
@@ -274,6 +280,7 @@ impl Sampler {
     /// independent fair bit, so we continue the scramble with 30 hash bits:
     /// `x + r · 2^-53`, `r < 2^30`, which is exact in f64, uniform on the `2^-53`
     /// grid of `[0, 1)` and at most `1 − 2^-53` (never 1).
+    #[inline(always)]
     fn sobol<const N: usize>(&mut self) -> [f64; N] {
         let x = sobol_burley::sample_4d(self.index(), 0, self.seed(self.draw));
         if self.draw == 0 {

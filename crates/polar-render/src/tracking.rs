@@ -50,6 +50,7 @@ fn step(rate: f64, u: f64) -> f64 {
 /// `t ∝ σ_t e^{−σ_t t}`, weight `σ_s / σ_t` at an event and 1 past the end. Grid:
 /// delta tracking with majorant `σ_t · max density`, the same weights. Without
 /// scattering (`σ_s = 0`) no event is sampled and the weight is the transmittance.
+#[inline(always)]
 pub(crate) fn flight<'a>(
     m: &'a Medium,
     o: &Vec3,

@@ -150,6 +150,7 @@ impl<'a> World<'a> {
     }
 
     /// Closest surface along a unit direction.
+    #[inline(always)]
     pub fn intersect(&self, o: &Vec3, d: &Vec3) -> Option<SurfaceHit> {
         let hit = self.accel.closest(o, d, 0.0, f64::INFINITY)?;
         Some(self.accel.surface(self.scene, hit, o, d))
@@ -158,6 +159,7 @@ impl<'a> World<'a> {
     /// The first scattering event along `o + t d` before the surface `hit` (if any),
     /// or passing through (always `Pass` with weight 1, drawing no random numbers,
     /// without a medium: the distance to the hit is only computed with one).
+    #[inline(always)]
     pub fn flight(
         &self,
         o: &Vec3,
@@ -239,6 +241,7 @@ impl<'a> World<'a> {
     /// Samples one light with extent (environment or emissive shape) as seen from
     /// `p` with shading normal `n` (`None` in a medium; visibility not tested);
     /// suns are in [`Self::sun_samples`].
+    #[inline(always)]
     pub fn sample_light(&self, p: &Vec3, n: Option<&Vec3>, u: [f64; 3]) -> Option<LightSample> {
         if self.lights.is_empty() {
             return None;

@@ -62,6 +62,7 @@ pub struct PlaneElements {
 impl PlaneElements {
     /// The plane matrix in this crate's frame (x = `e_⊥`):
     /// `[[s11, −s12, 0, 0], [−s12, s22, 0, 0], [0, 0, s33, s34], [0, 0, −s34, s44]]`.
+    #[inline(always)]
     pub fn to_block(&self) -> BlockDiagonal {
         BlockDiagonal {
             upper: Matrix2::new(self.s11, -self.s12, -self.s12, self.s22),
@@ -70,6 +71,7 @@ impl PlaneElements {
     }
 
     /// The elements scaled by `f`.
+    #[inline(always)]
     fn scaled(&self, f: f64) -> Self {
         Self {
             s11: self.s11 * f,
@@ -150,6 +152,7 @@ impl PhaseFunction {
 
     /// The normalised elements at scattering cosine `cos_theta` (clamped to `[−1, 1]`
     /// against rounding; NaN gives NaN).
+    #[inline(always)]
     pub fn plane_elements(&self, cos_theta: f64) -> PlaneElements {
         let mu = cos_theta.clamp(-1.0, 1.0);
         match self {
@@ -165,6 +168,7 @@ impl PhaseFunction {
     }
 
     /// The phase matrix in the scattering-plane frame (x = `e_⊥`, see the module docs).
+    #[inline(always)]
     pub fn plane_matrix(&self, cos_theta: f64) -> Mueller {
         self.plane_elements(cos_theta).to_block().to_mueller()
     }
@@ -172,12 +176,14 @@ impl PhaseFunction {
     /// The world-frame phase matrix from `stokes_basis(k_in)` to `stokes_basis(k_out)`
     /// (unit directions of propagation). Finite for `k_out = ±k_in`, where the plane is
     /// undefined and the matrix does not depend on it.
+    #[inline(always)]
     pub fn eval(&self, k_in: &Vector3<f64>, k_out: &Vector3<f64>) -> Mueller {
         from_scattering_plane(&self.plane_matrix(k_in.dot(k_out)), k_in, k_out)
     }
 
     /// Solid-angle density of [`PhaseFunction::sample`] at scattering cosine `cos_theta`;
     /// equal to `S11` (the `M00` of [`PhaseFunction::eval`]; for Mie, of the table).
+    #[inline(always)]
     pub fn pdf(&self, cos_theta: f64) -> f64 {
         let mu = cos_theta.clamp(-1.0, 1.0);
         match self {
@@ -190,6 +196,7 @@ impl PhaseFunction {
     /// Samples a scattered direction for light propagating along `k_in` from two uniform
     /// numbers in `[0, 1)`: `u[0]` picks cos θ by exact inversion of the CDF, `u[1]` the
     /// azimuth. Returns `(k_out, pdf)`, the pdf per solid angle.
+    #[inline(always)]
     pub fn sample(&self, k_in: &Vector3<f64>, u: [f64; 2]) -> (Vector3<f64>, f64) {
         let mu = self.sample_cos_theta(u[0]);
         (direction_about(k_in, mu, u[1]), self.pdf(mu))
@@ -205,6 +212,7 @@ impl PhaseFunction {
     /// `s = (1 − g²)/(1 + g v)`, `v = 2u − 1`, rewritten without the division by `g`:
     /// `μ = (v + g (3 − g² + (1 + g²) v² + 2g v)/2) / (1 + g v)²` (exact at `g = 0`).
     /// Mie: the tabulated CDF (see [`MieTable::sample_cos_theta`]).
+    #[inline(always)]
     pub fn sample_cos_theta(&self, u: f64) -> f64 {
         let mu = match *self {
             Self::Rayleigh => {
@@ -244,6 +252,7 @@ impl PhaseFunction {
 }
 
 /// Rayleigh's elements up to the factor `RAYLEIGH_NORM`: `(1 + μ², μ² − 1, 1 + μ², 2μ, 0, 2μ)`.
+#[inline(always)]
 fn rayleigh_shape(mu: f64) -> PlaneElements {
     let a = 1.0 + mu * mu;
     PlaneElements {
@@ -268,6 +277,7 @@ fn henyey_greenstein(g: f64, mu: f64) -> f64 {
 
 /// The unit direction at cosine `mu` from `k` and azimuth `2π u` about it, measured from
 /// `stokes_basis(k)`.
+#[inline(always)]
 fn direction_about(k: &Vector3<f64>, mu: f64, u: f64) -> Vector3<f64> {
     let x = stokes_basis(k);
     let y = k.cross(&x);
