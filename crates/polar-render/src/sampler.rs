@@ -201,7 +201,8 @@ impl Sampler {
     /// the chain of reflect/refract choices depend on the position in the pixel, this
     /// stratifies them jointly; padded draws only stratify each draw by itself. Other
     /// vertices keep a padded 3-D draw, whose choice and 2-D point are stratified
-    /// together. Numbers not used are free ones. Measured: see the module documentation.
+    /// together. Numbers not used take the place of free ones but are not
+    /// computed (NaN, see `path_or_free`). Measured: see the module documentation.
     #[inline(always)]
     pub fn next_scatter(&mut self, depth: u32, choice: bool, point: bool) -> [f64; 3] {
         if self.kind == SamplerKind::Independent || (depth > 0 && point) {
