@@ -27,6 +27,15 @@ fn reads_only(bsdf: &Bsdf, wo: &V3, u: [f64; 3], read: [bool; 3]) -> bool {
         })
 }
 
+/// The shared fixture named `wanted`.
+fn by_name(wanted: &str) -> Bsdf {
+    all_bsdfs()
+        .into_iter()
+        .find(|(n, _)| *n == wanted)
+        .unwrap_or_else(|| panic!("no fixture {wanted}"))
+        .1
+}
+
 /// The BSDFs of the shared fixtures, and again with a camera row (glass and
 /// plastic then choose their lobes by it).
 fn bsdfs_with_importance() -> Vec<(String, Bsdf)> {
@@ -62,13 +71,6 @@ fn bsdfs_read_only_the_numbers_they_need() {
 
 #[test]
 fn a_smooth_mirror_reads_nothing_and_smooth_glass_its_choice() {
-    let by_name = |wanted| {
-        all_bsdfs()
-            .into_iter()
-            .find(|(n, _)| *n == wanted)
-            .unwrap()
-            .1
-    };
     assert_eq!(readable(&by_name("smooth_conductor")), [false; 3]);
     assert_eq!(readable(&by_name("polarizer")), [false; 3]);
     assert_eq!(
@@ -81,13 +83,6 @@ fn a_smooth_mirror_reads_nothing_and_smooth_glass_its_choice() {
 fn the_check_sees_a_number_that_is_read() {
     // The test above can fail: a rough conductor reads u[1] and u[2], and glass
     // reads u[0] (at 45°, reflectance ~5 %: u = 0.01 reflects, 1 − ε refracts).
-    let by_name = |wanted| {
-        all_bsdfs()
-            .into_iter()
-            .find(|(n, _)| *n == wanted)
-            .unwrap()
-            .1
-    };
     let rough = by_name("rough_conductor_iso");
     assert!(!reads_only(
         &rough,
