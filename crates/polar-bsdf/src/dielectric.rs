@@ -31,6 +31,44 @@ pub struct Dielectric {
     pub importance: Option<Stokes>,
 }
 
+/// The reflect/refract choice at a smooth interface (one Fresnel evaluation).
+struct SmoothChoice {
+    fresnel: polar_optics::fresnel::FresnelAmplitudes,
+    /// Probability of reflection (1 under total internal reflection).
+    reflect_prob: f64,
+    /// Refracted direction and relative index `n(wi side) / n(wo side)`; `None`
+    /// under total internal reflection.
+    transmitted: Option<(V3, f64)>,
+}
+
+impl SmoothChoice {
+    /// The reflected lobe, its matrix divided by its probability.
+    #[inline(always)]
+    fn reflection(&self, wo: &V3) -> BsdfSample {
+        let wr = reflect_z(wo);
+        let r = from_sp_frame(&self.fresnel.reflection_block(), &V3::z(), wo, &wr);
+        BsdfSample::reflection(wr, r / self.reflect_prob, self.reflect_prob, true)
+    }
+
+    /// The transmitted lobe (radiance: `1/η²`), its matrix divided by its
+    /// probability; `None` under total internal reflection.
+    #[inline(always)]
+    fn transmission(&self, wo: &V3) -> Option<BsdfSample> {
+        let (wt, etap) = self.transmitted?;
+        let t =
+            from_sp_frame(&self.fresnel.transmission_block(), &V3::z(), wo, &wt) / (etap * etap);
+        let pt = 1.0 - self.reflect_prob;
+        Some(BsdfSample {
+            wi: wt,
+            weight: t / pt,
+            pdf: pt,
+            is_delta: true,
+            is_transmission: true,
+            eta: etap,
+        })
+    }
+}
+
 impl Dielectric {
     /// `n(other side) / n(side of w)`.
     fn etap(&self, w: &V3) -> f64 {
@@ -53,36 +91,51 @@ impl Dielectric {
         }
     }
 
-    /// One Fresnel evaluation serves both lobes: the flux-unit transmission
-    /// matrix in the s/p frame is the same from either side (Stokes relations;
-    /// tested in polar-optics), so that of light leaving along `wo` is used.
+    /// The lobe choice of a smooth interface for light leaving along `wo`. One
+    /// Fresnel evaluation serves both lobes: the flux-unit transmission matrix in
+    /// the s/p frame is the same from either side (Stokes relations; tested in
+    /// polar-optics), so that of light leaving along `wo` is used.
     #[inline(always)]
-    fn smooth_sample(&self, wo: &V3, u: f64) -> Option<BsdfSample> {
+    fn smooth_choice(&self, wo: &V3) -> SmoothChoice {
         let etap = self.etap(wo);
-        let wr = reflect_z(wo);
         let fresnel = fresnel_amplitudes(wo.z.abs(), etap.into());
-        // The choice needs column 0 only; the full reflection matrix is formed
-        // only when reflection is taken (glass transmits most paths).
-        let r = self.reflect_prob_of(&fresnel.reflected_unpolarized(), &V3::z(), wo);
-        let r_mueller = || from_sp_frame(&fresnel.reflection_block(), &V3::z(), wo, &wr);
         let n = V3::z() * wo.z.signum();
         match refract(wo, &n, etap) {
-            Some(wt) if u >= r => {
-                let t =
-                    from_sp_frame(&fresnel.transmission_block(), &V3::z(), wo, &wt) / (etap * etap);
-                let pt = 1.0 - r;
-                Some(BsdfSample {
-                    wi: wt,
-                    weight: t / pt,
-                    pdf: pt,
-                    is_delta: true,
-                    is_transmission: true,
-                    eta: etap,
-                })
-            }
-            Some(_) => Some(BsdfSample::reflection(wr, r_mueller() / r, r, true)),
-            None => Some(BsdfSample::reflection(wr, r_mueller(), 1.0, true)),
+            Some(wt) => SmoothChoice {
+                // The choice needs column 0 only; the full reflection matrix is
+                // formed only when reflection is taken (glass transmits most paths).
+                reflect_prob: self.reflect_prob_of(&fresnel.reflected_unpolarized(), &V3::z(), wo),
+                transmitted: Some((wt, etap)),
+                fresnel,
+            },
+            None => SmoothChoice {
+                reflect_prob: 1.0,
+                transmitted: None,
+                fresnel,
+            },
         }
+    }
+
+    #[inline(always)]
+    fn smooth_sample(&self, wo: &V3, u: f64) -> Option<BsdfSample> {
+        let choice = self.smooth_choice(wo);
+        Some(if u >= choice.reflect_prob {
+            choice.transmission(wo)?
+        } else {
+            choice.reflection(wo)
+        })
+    }
+
+    /// Both outcomes of the lobe choice of a smooth interface, as
+    /// [`Model::sample`] returns them, when both are possible (see
+    /// [`crate::Bsdf::lobe_outcomes`]).
+    pub(crate) fn lobe_outcomes(&self, wo: &V3) -> Option<[BsdfSample; 2]> {
+        if self.roughness.is_some() || wo.z == 0.0 {
+            return None;
+        }
+        let choice = self.smooth_choice(wo);
+        let both = choice.reflect_prob > 0.0 && choice.reflect_prob < 1.0;
+        both.then(|| choice.transmission(wo).map(|t| [choice.reflection(wo), t]))?
     }
 
     /// The generalized half vector of `(wo, wi)` facing `+z`, the relative index

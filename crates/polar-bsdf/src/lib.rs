@@ -181,6 +181,20 @@ impl Bsdf {
         }
     }
 
+    /// Both outcomes of the lobe choice that [`Self::sample`] would make, each as
+    /// `sample` returns it (weight = matrix / probability, `pdf` = the
+    /// probability), for a BSDF whose lobes are all deltas when both outcomes are
+    /// possible: a smooth dielectric, except under total internal reflection.
+    /// A renderer that traces both and weighs each by its `pdf` computes the
+    /// expectation over the choice instead of drawing it (splitting, as branched
+    /// path tracing does at the first hit). `None` for every other BSDF.
+    pub fn lobe_outcomes(&self, wo: &Vector3<f64>) -> Option<[BsdfSample; 2]> {
+        match self {
+            Bsdf::Dielectric(d) => d.lobe_outcomes(wo),
+            Bsdf::Lambertian(_) | Bsdf::Conductor(_) | Bsdf::Plastic(_) | Bsdf::Sheet(_) => None,
+        }
+    }
+
     /// Whether this BSDF chooses between lobes, i.e. whether
     /// [`Self::with_importance`] can change it (glass and plastic).
     pub fn chooses_lobes(&self) -> bool {

@@ -230,3 +230,36 @@ fn plastic_choice_follows_the_camera_row() {
         assert!(p(Stokes::new(1.0, 1.0, 0.0, 0.0)) < 1e-5);
     }
 }
+
+#[test]
+fn lobe_outcomes_are_the_two_samples_of_the_choice() {
+    // `Bsdf::lobe_outcomes` gives exactly (same arithmetic, so bit for bit) the
+    // reflection and the transmission that `sample` returns on either side of the
+    // choice, unaimed and aimed; their probabilities sum to 1. Under total
+    // internal reflection there is one outcome, so nothing to split: None.
+    for (view, wo) in glass_views() {
+        for bsdf in [glass(), glass().with_importance(&wo, &camera_rows(3)[5])] {
+            let samples = delta_samples(&bsdf, &wo);
+            match bsdf.lobe_outcomes(&wo) {
+                Some(both) => {
+                    assert_eq!(both.to_vec(), samples, "{view}");
+                    let total: f64 = both.iter().map(|s| s.pdf).sum();
+                    assert!((total - 1.0).abs() < 1e-15, "{view}: Σp = {total}");
+                }
+                None => assert_eq!(samples.len(), 1, "{view}: two outcomes not split"),
+            }
+        }
+    }
+    assert!(glass().lobe_outcomes(&dir(120.0, 130.0)).is_none());
+}
+
+#[test]
+fn only_smooth_glass_has_lobe_outcomes() {
+    // Rough glass draws a microfacet first, plastic's lobes are not both deltas,
+    // the other BSDFs have one lobe: none of them is split.
+    let wo = dir(35.0, 80.0);
+    for (name, bsdf) in all_bsdfs() {
+        let split = bsdf.lobe_outcomes(&wo).is_some();
+        assert_eq!(split, name == "smooth_dielectric", "{name}");
+    }
+}

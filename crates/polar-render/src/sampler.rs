@@ -68,6 +68,11 @@ const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 const SEED_DOMAIN: u64 = 0x5b0b_5eed_0000_0000;
 const LOW_BITS_DOMAIN: u64 = 0x10e5_b175_0000_0000;
 const PATH_LOW_BITS_DOMAIN: u64 = 0x9a7b_b175_0000_0000;
+const BRANCH_DOMAIN: u64 = 0xb2a4_c400_0000_0000;
+
+/// Offset of a split path's aligned draws (a path makes at most 3 per vertex,
+/// and `max_depth` is far below this).
+const BRANCH_DRAWS: u64 = 1 << 20;
 
 /// `sobol_burley` supports sample indices below 2^16; each further block of 2^16
 /// samples gets its own scramble seed (an independent Owen-scrambled net).
@@ -212,6 +217,22 @@ impl Sampler {
         let u0 = self.path_or_free(choice);
         let u1 = self.path_or_free(point);
         [u0, u1, self.path_or_free(point)]
+    }
+
+    /// The stream of a second path split off this sample's path at its camera
+    /// vertex (both outcomes of a lobe choice, see the integrator): its aligned
+    /// draws continue this stream's under other scramble seeds (each still
+    /// stratified over the pixel's samples), its free numbers come from another
+    /// hash key, and it has no path point (its delta vertices choose with free
+    /// numbers), so that its numbers are independent of the first path's.
+    pub fn branch(&self) -> Sampler {
+        Sampler {
+            key: mix(self.key ^ BRANCH_DOMAIN),
+            draw: self.draw + BRANCH_DRAWS,
+            path_set: None,
+            path_next: sobol_burley::NUM_DIMENSIONS,
+            ..self.clone()
+        }
     }
 
     /// The number for the first free-flight step of a ray in a medium: the path
@@ -530,6 +551,31 @@ mod tests {
             assert_eq!(a.next_scatter(depth, choice, point), b.next_3d());
             assert_eq!(a.next_flight(), b.next_free());
         }
+    }
+
+    #[test]
+    fn a_branch_is_reproducible_stratified_and_independent_of_its_parent() {
+        let streams = PixelStreams::new(5, 77, SamplerKind::Sobol);
+        let after_camera = |i| {
+            let mut s = streams.sample(i);
+            s.next_2d();
+            s
+        };
+        // Its padded draws are (0,10,2)-nets over the pixel's 1024 samples.
+        let points: Vec<[f64; 2]> = (0..1 << 10)
+            .map(|i| after_camera(i).branch().next_2d())
+            .collect();
+        assert!(is_net(&points));
+        let (mut parent, mut branch) = (after_camera(3), after_camera(3).branch());
+        assert_eq!(after_camera(3).branch().next_3d(), branch.clone().next_3d());
+        assert_ne!(branch.next_3d(), parent.next_3d());
+        assert_ne!(branch.next_free(), parent.next_free());
+        // No path point: a delta vertex's choice is a free number.
+        let mut free = after_camera(3).branch();
+        assert_eq!(
+            after_camera(3).branch().next_scatter(1, true, false)[0],
+            free.next_free()
+        );
     }
 
     #[test]
