@@ -14,7 +14,7 @@ use crate::geometry::{
 };
 use crate::lobe::first_lobe_probability;
 use crate::microfacet::Ggx;
-use crate::{BsdfSample, Model, Polarization};
+use crate::{BsdfSample, LobeOutcome, Model, Polarization};
 use polar_optics::fresnel::fresnel_amplitudes;
 use polar_optics::{Mueller, Stokes};
 
@@ -126,16 +126,23 @@ impl Dielectric {
         })
     }
 
-    /// Both outcomes of the lobe choice of a smooth interface, as
-    /// [`Model::sample`] returns them, when both are possible (see
-    /// [`crate::Bsdf::lobe_outcomes`]).
-    pub(crate) fn lobe_outcomes(&self, wo: &V3) -> Option<[BsdfSample; 2]> {
+    /// Both outcomes of the lobe choice of a smooth interface, reflection first,
+    /// when both are possible (see [`crate::Bsdf::lobe_outcomes`]).
+    pub(crate) fn lobe_outcomes(&self, wo: &V3) -> Option<[LobeOutcome; 2]> {
         if self.roughness.is_some() || wo.z == 0.0 {
             return None;
         }
         let choice = self.smooth_choice(wo);
         let both = choice.reflect_prob > 0.0 && choice.reflect_prob < 1.0;
-        both.then(|| choice.transmission(wo).map(|t| [choice.reflection(wo), t]))?
+        let outcome = |s: BsdfSample| LobeOutcome {
+            probability: s.pdf,
+            sample: Some(s),
+        };
+        both.then(|| {
+            choice
+                .transmission(wo)
+                .map(|t| [outcome(choice.reflection(wo)), outcome(t)])
+        })?
     }
 
     /// The generalized half vector of `(wo, wi)` facing `+z`, the relative index

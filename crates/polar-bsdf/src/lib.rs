@@ -102,6 +102,15 @@ impl BsdfSample {
     }
 }
 
+/// One outcome of a BSDF's lobe choice ([`Bsdf::lobe_outcomes`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LobeOutcome {
+    /// Probability with which [`Bsdf::sample`] makes this choice.
+    pub probability: f64,
+    /// What `sample` returns with this choice (`None`: no light arrives).
+    pub sample: Option<BsdfSample>,
+}
+
 /// A polarized BSDF at one surface point (a closed set, one `match` per method).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bsdf {
@@ -181,17 +190,20 @@ impl Bsdf {
         }
     }
 
-    /// Both outcomes of the lobe choice that [`Self::sample`] would make, each as
-    /// `sample` returns it (weight = matrix / probability, `pdf` = the
-    /// probability), for a BSDF whose lobes are all deltas when both outcomes are
-    /// possible: a smooth dielectric, except under total internal reflection.
-    /// A renderer that traces both and weighs each by its `pdf` computes the
-    /// expectation over the choice instead of drawing it (splitting, as branched
-    /// path tracing does at the first hit). `None` for every other BSDF.
-    pub fn lobe_outcomes(&self, wo: &Vector3<f64>) -> Option<[BsdfSample; 2]> {
+    /// Both outcomes of the lobe choice that [`Self::sample`] makes with `u[0]`,
+    /// each with its probability and the sample it gives with the 2-D point `u`
+    /// (what `sample` returns for that choice): glass's reflection and
+    /// transmission when smooth (except under total internal reflection),
+    /// plastic's specular and diffuse lobes. A renderer that traces both and
+    /// weighs each by its probability computes the expectation over the choice
+    /// instead of drawing it (splitting, as branched path tracing does at the
+    /// first hit); the samples' densities are those of `sample` and `pdf`, so MIS
+    /// against light sampling is unchanged. `None` for every other BSDF.
+    pub fn lobe_outcomes(&self, wo: &Vector3<f64>, u: [f64; 2]) -> Option<[LobeOutcome; 2]> {
         match self {
             Bsdf::Dielectric(d) => d.lobe_outcomes(wo),
-            Bsdf::Lambertian(_) | Bsdf::Conductor(_) | Bsdf::Plastic(_) | Bsdf::Sheet(_) => None,
+            Bsdf::Plastic(p) => p.lobe_outcomes(wo, u),
+            Bsdf::Lambertian(_) | Bsdf::Conductor(_) | Bsdf::Sheet(_) => None,
         }
     }
 

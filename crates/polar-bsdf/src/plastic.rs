@@ -23,7 +23,7 @@ use crate::geometry::{
 };
 use crate::lobe::first_lobe_probability;
 use crate::microfacet::Ggx;
-use crate::{BsdfSample, Model, Polarization};
+use crate::{BsdfSample, LobeOutcome, Model, Polarization};
 use polar_optics::fresnel::fresnel_amplitudes;
 use polar_optics::{Mueller, Stokes};
 use std::f64::consts::FRAC_1_PI;
@@ -93,6 +93,43 @@ impl Plastic {
     fn diffuse_prob(&self) -> f64 {
         1.0 - self.specular_prob
     }
+
+    /// Samples the specular lobe (`specular`) or the diffuse one with the 2-D point
+    /// `u`; the weight is the whole BSDF over the mixture's density (a delta
+    /// specular lobe: its matrix over its probability), as [`Model::sample`].
+    #[inline(always)]
+    fn sample_lobe(&self, specular: bool, wo: &V3, u: [f64; 2]) -> Option<BsdfSample> {
+        let wi = match (&self.roughness, specular) {
+            (None, true) => {
+                let wi = reflect_z(wo);
+                let weight = reflection(self.eta.into(), &V3::z(), wo, &wi) / self.specular_prob;
+                let pdf = self.specular_prob;
+                return Some(BsdfSample::reflection(wi, weight, pdf, true));
+            }
+            (Some(ggx), true) => reflect(wo, &ggx.sample_visible(wo, u)),
+            (_, false) => cosine_hemisphere(u),
+        };
+        let pdf = self.pdf(wo, &wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        let weight = self.eval(wo, &wi) / pdf;
+        Some(BsdfSample::reflection(wi, weight, pdf, false))
+    }
+
+    /// Both outcomes of the lobe choice, specular first, with the 2-D point `u`
+    /// (see [`crate::Bsdf::lobe_outcomes`]); `None` when only one is possible.
+    pub(crate) fn lobe_outcomes(&self, wo: &V3, u: [f64; 2]) -> Option<[LobeOutcome; 2]> {
+        let both = wo.z > 0.0 && self.specular_prob > 0.0 && self.specular_prob < 1.0;
+        both.then(|| {
+            [(true, self.specular_prob), (false, self.diffuse_prob())].map(
+                |(specular, probability)| LobeOutcome {
+                    probability,
+                    sample: self.sample_lobe(specular, wo, u),
+                },
+            )
+        })
+    }
 }
 
 impl Model for Plastic {
@@ -122,22 +159,7 @@ impl Model for Plastic {
         if wo.z <= 0.0 {
             return None;
         }
-        let wi = match (&self.roughness, u[0] < self.specular_prob) {
-            (None, true) => {
-                let wi = reflect_z(wo);
-                let weight = reflection(self.eta.into(), &V3::z(), wo, &wi) / self.specular_prob;
-                let pdf = self.specular_prob;
-                return Some(BsdfSample::reflection(wi, weight, pdf, true));
-            }
-            (Some(ggx), true) => reflect(wo, &ggx.sample_visible(wo, [u[1], u[2]])),
-            (_, false) => cosine_hemisphere([u[1], u[2]]),
-        };
-        let pdf = self.pdf(wo, &wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        let weight = self.eval(wo, &wi) / pdf;
-        Some(BsdfSample::reflection(wi, weight, pdf, false))
+        self.sample_lobe(u[0] < self.specular_prob, wo, [u[1], u[2]])
     }
 
     fn has_delta(&self) -> bool {

@@ -232,34 +232,81 @@ fn plastic_choice_follows_the_camera_row() {
 }
 
 #[test]
-fn lobe_outcomes_are_the_two_samples_of_the_choice() {
+fn glass_lobe_outcomes_are_the_two_samples_of_the_choice() {
     // `Bsdf::lobe_outcomes` gives exactly (same arithmetic, so bit for bit) the
     // reflection and the transmission that `sample` returns on either side of the
-    // choice, unaimed and aimed; their probabilities sum to 1. Under total
-    // internal reflection there is one outcome, so nothing to split: None.
+    // choice, unaimed and aimed, with the samples' probabilities, which sum to 1.
+    // Under total internal reflection there is one outcome, so nothing to split.
     for (view, wo) in glass_views() {
         for bsdf in [glass(), glass().with_importance(&wo, &camera_rows(3)[5])] {
             let samples = delta_samples(&bsdf, &wo);
-            match bsdf.lobe_outcomes(&wo) {
+            match bsdf.lobe_outcomes(&wo, [0.3, 0.6]) {
                 Some(both) => {
-                    assert_eq!(both.to_vec(), samples, "{view}");
-                    let total: f64 = both.iter().map(|s| s.pdf).sum();
+                    for (outcome, sample) in both.iter().zip(&samples) {
+                        assert_eq!(outcome.sample.as_ref(), Some(sample), "{view}");
+                        assert_eq!(outcome.probability, sample.pdf, "{view}");
+                    }
+                    let total: f64 = both.iter().map(|o| o.probability).sum();
                     assert!((total - 1.0).abs() < 1e-15, "{view}: Σp = {total}");
                 }
                 None => assert_eq!(samples.len(), 1, "{view}: two outcomes not split"),
             }
         }
     }
-    assert!(glass().lobe_outcomes(&dir(120.0, 130.0)).is_none());
+    assert!(
+        glass()
+            .lobe_outcomes(&dir(120.0, 130.0), [0.3, 0.6])
+            .is_none()
+    );
 }
 
 #[test]
-fn only_smooth_glass_has_lobe_outcomes() {
-    // Rough glass draws a microfacet first, plastic's lobes are not both deltas,
-    // the other BSDFs have one lobe: none of them is split.
+fn plastic_lobe_outcomes_are_the_two_samples_of_the_choice() {
+    // The specular and the diffuse outcome are what `sample` returns with u[0]
+    // below and above the specular probability and the same 2-D point, bit for
+    // bit, unaimed and aimed (smooth and rough coatings, random points and views);
+    // the probabilities are the choice's. None seen from below the surface.
+    let mut rng = rng(4);
+    for (name, bsdf) in all_bsdfs()
+        .into_iter()
+        .filter(|(n, _)| n.ends_with("plastic"))
+    {
+        let Bsdf::Plastic(plastic) = bsdf else {
+            unreachable!("{name}")
+        };
+        for _ in 0..50 {
+            let (wo, u) = (hemisphere(&mut rng), u3(&mut rng));
+            for b in [bsdf, bsdf.with_importance(&wo, &camera_rows(5)[7])] {
+                let Bsdf::Plastic(p) = b else { unreachable!() };
+                let both = b.lobe_outcomes(&wo, [u[1], u[2]]).expect(name);
+                let (specular, diffuse) = (&both[0], &both[1]);
+                assert_eq!(specular.probability, p.specular_prob, "{name}");
+                assert_eq!(diffuse.probability, 1.0 - p.specular_prob, "{name}");
+                assert_eq!(specular.sample, b.sample(&wo, [0.0, u[1], u[2]]), "{name}");
+                assert_eq!(
+                    diffuse.sample,
+                    b.sample(&wo, [1.0 - 1e-16, u[1], u[2]]),
+                    "{name}"
+                );
+            }
+            let below = V3::new(wo.x, wo.y, -wo.z);
+            assert!(bsdf.lobe_outcomes(&below, [u[1], u[2]]).is_none(), "{name}");
+        }
+        assert!(plastic.specular_prob > 0.0 && plastic.specular_prob < 1.0);
+    }
+}
+
+#[test]
+fn only_smooth_glass_and_plastic_have_lobe_outcomes() {
+    // Rough glass draws its microfacet before its choice; the other BSDFs have
+    // one lobe: none of them is split.
     let wo = dir(35.0, 80.0);
     for (name, bsdf) in all_bsdfs() {
-        let split = bsdf.lobe_outcomes(&wo).is_some();
-        assert_eq!(split, name == "smooth_dielectric", "{name}");
+        let split = bsdf.lobe_outcomes(&wo, [0.3, 0.6]).is_some();
+        assert_eq!(
+            split,
+            name == "smooth_dielectric" || name.ends_with("plastic"),
+            "{name}"
+        );
     }
 }
