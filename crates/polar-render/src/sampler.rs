@@ -207,7 +207,9 @@ impl Sampler {
     /// stratifies them jointly; padded draws only stratify each draw by itself. Other
     /// vertices keep a padded 3-D draw, whose choice and 2-D point are stratified
     /// together. Numbers not used take the place of free ones but are not
-    /// computed (NaN, see `path_or_free`). Measured: see the module documentation.
+    /// computed (NaN, see `path_or_free`); where the integrator traces both
+    /// outcomes of the first vertex's choice (glass, plastic), `u[0]` is drawn and
+    /// not used. Measured: see the module documentation.
     #[inline(always)]
     pub fn next_scatter(&mut self, depth: u32, choice: bool, point: bool) -> [f64; 3] {
         if self.kind == SamplerKind::Independent || (depth > 0 && point) {
