@@ -70,8 +70,9 @@ const LOW_BITS_DOMAIN: u64 = 0x10e5_b175_0000_0000;
 const PATH_LOW_BITS_DOMAIN: u64 = 0x9a7b_b175_0000_0000;
 const BRANCH_DOMAIN: u64 = 0xb2a4_c400_0000_0000;
 
-/// Offset of a split path's aligned draws (a path makes at most 3 per vertex,
-/// and `max_depth` is far below this).
+/// Offset of a split path's aligned draws. A path makes at most 3 per vertex, so
+/// only a path past vertex 349,525 (Russian roulette ends paths long before)
+/// would share scramble seeds with its branch: correlated numbers, still unbiased.
 const BRANCH_DRAWS: u64 = 1 << 20;
 
 /// `sobol_burley` supports sample indices below 2^16; each further block of 2^16
