@@ -225,9 +225,9 @@ fn glass_front_reflection_is_traced_not_drawn() {
     // With max_depth 1 a camera sample through the sphere's front brings its
     // reflection alone: R00 of the incidence angle at the jittered point, the same
     // for any seed up to the angle's spread over the pixel. Drawing reflection or
-    // transmission instead would give 1 or 0. A pixel spans 1.6 deg of view, up to
-    // 9 deg of incidence where R00 < 0.05 (incidence below 50 deg), over which R00
-    // changes by under 0.01 (0.040 at normal incidence, 0.050 at 50 deg).
+    // transmission instead would give 1 or 0. A pixel spans 1.6 deg of view, under
+    // 9 deg of incidence where R00 < 0.05 (incidence below 45 deg), over which R00
+    // changes by under 0.01 (0.040 at normal incidence, 0.050 at 45 deg).
     let r: Vec<f64> = glass_sphere_samples(25.0, 16, 1)
         .into_iter()
         .map(|(_, r)| r)
