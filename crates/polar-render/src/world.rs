@@ -8,7 +8,6 @@ use crate::scene::{Emission, Light, Scene, Vec3};
 use crate::tracking::{self, Flight};
 use polar_optics::Stokes;
 use polar_optics::sky::RayleighSky;
-use std::f64::consts::PI;
 
 /// A light with extent, as the integrator picks it (uniformly among them; suns,
 /// being delta lights, are not picked but all sampled at every vertex).
@@ -52,10 +51,9 @@ pub(crate) struct LightSample {
     pub dist: f64,
     /// Incident Stokes vector in the implicit frame of its propagation direction `-wi`.
     pub stokes: Stokes,
-    /// Solid-angle density including the light choice; 1 for a sun.
+    /// Solid-angle density including the light choice; 1 for a sun (a delta
+    /// distribution: no MIS).
     pub pdf: f64,
-    /// The light is a delta distribution (sun): no MIS.
-    pub is_delta: bool,
 }
 
 /// The prepared scene.
@@ -71,21 +69,13 @@ pub(crate) struct World<'a> {
     area_index: Vec<Option<usize>>,
 }
 
-/// Uniform direction on the sphere (for environment light seen from a medium point).
-fn sphere_direction(u: [f64; 2]) -> Vec3 {
-    let z = 1.0 - 2.0 * u[0];
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u[1];
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
-
-/// Cosine-weighted direction about `n` (Malley's method), in world space.
-fn cosine_direction(n: &Vec3, u: [f64; 2]) -> Vec3 {
-    let r = u[0].sqrt();
-    let phi = 2.0 * PI * u[1];
-    let x = polar_optics::stokes_basis(n);
-    let y = n.cross(&x);
-    x * (r * phi.cos()) + y * (r * phi.sin()) + n * (1.0 - u[0]).max(0.0).sqrt()
+/// What the light draw of a vertex picks among the lights with extent.
+pub(crate) enum PickedLight {
+    /// The environment, with the draw's 2-D point (the integrator chooses how to
+    /// sample a direction toward it).
+    Environment([f64; 2]),
+    /// A point on an emissive shape.
+    Area(LightSample),
 }
 
 impl<'a> World<'a> {
@@ -200,15 +190,10 @@ impl<'a> World<'a> {
         1.0 / self.lights.len() as f64
     }
 
-    /// Density (solid angle, with the light choice) with which [`Self::sample_light`]
-    /// would return direction `wi` toward the environment from a surface point with
-    /// shading normal `n` (cosine-weighted) or a medium point (`None`, uniform).
-    pub fn environment_pdf(&self, n: Option<&Vec3>, wi: &Vec3) -> f64 {
-        self.pick_probability()
-            * match n {
-                Some(n) => n.dot(wi).max(0.0) / PI,
-                None => 0.25 / PI,
-            }
+    /// Density (solid angle, with the light choice) with which light sampling reaches
+    /// the environment in a direction its directions have density `density` for.
+    pub fn environment_pdf(&self, density: f64) -> f64 {
+        self.pick_probability() * density
     }
 
     /// Density of reaching `hit` on an emissive shape from `from` by light sampling.
@@ -234,36 +219,21 @@ impl<'a> World<'a> {
             dist: f64::INFINITY,
             stokes: e.stokes(),
             pdf: 1.0,
-            is_delta: true,
         })
     }
 
-    /// Samples one light with extent (environment or emissive shape) as seen from
-    /// `p` with shading normal `n` (`None` in a medium; visibility not tested);
-    /// suns are in [`Self::sun_samples`].
+    /// Picks one light with extent (environment or emissive shape) with draw `u` and
+    /// samples a point on it as seen from `p` (visibility not tested); suns are in
+    /// [`Self::sun_samples`].
     #[inline(always)]
-    pub fn sample_light(&self, p: &Vec3, n: Option<&Vec3>, u: [f64; 3]) -> Option<LightSample> {
+    pub fn sample_light(&self, p: &Vec3, u: [f64; 3]) -> Option<PickedLight> {
         if self.lights.is_empty() {
             return None;
         }
         let pick = self.pick_probability();
         let index = ((u[0] * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
         match &self.lights[index] {
-            LightRef::Environment => {
-                let wi = match n {
-                    Some(n) => cosine_direction(n, [u[1], u[2]]),
-                    None => sphere_direction([u[1], u[2]]),
-                };
-                let pdf = self.environment_pdf(n, &wi);
-                let stokes = self.environment(&-wi)?;
-                (pdf > 0.0).then_some(LightSample {
-                    wi,
-                    dist: f64::INFINITY,
-                    stokes,
-                    pdf,
-                    is_delta: false,
-                })
-            }
+            LightRef::Environment => Some(PickedLight::Environment([u[1], u[2]])),
             LightRef::Area {
                 shape,
                 prims,
@@ -281,12 +251,13 @@ impl<'a> World<'a> {
                 let wi = to / dist;
                 let cos = -nl.dot(&wi);
                 let e = self.scene.shapes[*shape].emission?;
-                (cos > 0.0 && dist > 0.0).then(|| LightSample {
-                    wi,
-                    dist,
-                    stokes: e.stokes(),
-                    pdf: pick * dist * dist / (cos * area),
-                    is_delta: false,
+                (cos > 0.0 && dist > 0.0).then(|| {
+                    PickedLight::Area(LightSample {
+                        wi,
+                        dist,
+                        stokes: e.stokes(),
+                        pdf: pick * dist * dist / (cos * area),
+                    })
                 })
             }
         }
