@@ -17,7 +17,9 @@ Time-to-equal-error: for each curve, log(time) is interpolated piecewise
 linearly in log(error) between the measured points (no assumed convergence
 rate: low-discrepancy samplers converge faster than t^-1/2), and the time
 ratio Mitsuba / ours (> 1: ours is faster) is read at the errors Mitsuba
-reaches at 64, 256 and 1024 spp, where those lie inside our measured range. Two
+reaches at 64, 256 and 1024 spp, where those lie inside our measured range;
+where our fastest point is already below such an error, its time bounds ours
+and the ratio is a lower bound ("≥", also on a geometric mean it enters). Two
 pairs: Mitsuba independent / ours independent (also with the old fit
 error = c / sqrt(t), ratio (c_mitsuba / c_ours)^2, for continuity) and
 Mitsuba's low-discrepancy sampler (MITSUBA_LD) / ours `sobol`.
@@ -193,6 +195,13 @@ def time_at(rows, metric, level):
     return float(np.exp(np.interp(np.log(level), np.log(e[::-1]), np.log(t[::-1]))))
 
 
+def time_bound(rows, metric, level):
+    """When the curve's fastest point is already below error `level`: that
+    point's time, an upper bound on the time it needs; else NaN."""
+    t, e = frontier(rows, metric)
+    return float(t[0]) if len(e) and level > e[0] else float("nan")
+
+
 def error_at(rows, metric, seconds):
     """The error the curve reaches in `seconds`, interpolated like time_at; NaN outside its range."""
     t, e = frontier(rows, metric)
@@ -217,8 +226,13 @@ def compare(curves, mitsuba, ours_key):
         levels = []
         for spp in LEVEL_SPP:
             level = next((r[metric] for r in m_rows if r["spp"] == spp), float("nan"))
-            ratio = time_at(m_rows, metric, level) / time_at(o_rows, metric, level) if np.isfinite(level) else np.nan
-            levels.append({"spp": spp, "error": level, "ratio": float(ratio)})
+            t_ours = time_at(o_rows, metric, level)
+            # Our fastest point already below the level: its time bounds ours, the ratio from below.
+            bound = bool(np.isfinite(level) and not np.isfinite(t_ours))
+            if bound:
+                t_ours = time_bound(o_rows, metric, level)
+            ratio = time_at(m_rows, metric, level) / t_ours if np.isfinite(level) else np.nan
+            levels.append({"spp": spp, "error": level, "ratio": float(ratio), "lower_bound": bound and np.isfinite(ratio)})
         out[metric] = levels
         if mitsuba.endswith("/independent") and ours_key.endswith("/independent"):
             out[f"fit_{metric}"] = (fit_c(m_rows, metric) / fit_c(o_rows, metric)) ** 2
@@ -255,7 +269,8 @@ def sampler_study(curves):
 
 def fmt_ratio(cell):
     r, e = cell["ratio"], cell["error"]
-    return f"{r:.2f}x @{100 * e:.3g}%" if np.isfinite(r) else (f"out of range @{100 * e:.3g}%" if np.isfinite(e) else "-")
+    at_least = "≥" if cell.get("lower_bound") else ""
+    return f"{at_least}{r:.2f}x @{100 * e:.3g}%" if np.isfinite(r) else (f"out of range @{100 * e:.3g}%" if np.isfinite(e) else "-")
 
 
 def time_exponent(rows):
@@ -298,10 +313,10 @@ def print_comparisons(results, pixels, clock):
             kind = pair
             for i, c in enumerate(c for metric in METRICS for c in cmp[metric]):
                 if np.isfinite(c["ratio"]):
-                    geo.setdefault(kind, {}).setdefault(i, []).append(c["ratio"])
+                    geo.setdefault(kind, {}).setdefault(i, []).append((c["ratio"], c.get("lower_bound", False)))
     for kind, cols in geo.items():
-        cells = [f"{np.exp(np.mean(np.log(cols[i]))):.2f}x ({len(cols[i])})" if i in cols else "-"
-                 for i in range(len(hdr))]
+        cells = [f"{'≥' if any(b for _, b in cols[i]) else ''}{np.exp(np.mean(np.log([r for r, _ in cols[i]]))):.2f}x"
+                 f" ({len(cols[i])})" if i in cols else "-" for i in range(len(hdr))]
         print(f"| geometric mean (scenes) | {kind} | | " + " | ".join(cells) + " | |")
 
 

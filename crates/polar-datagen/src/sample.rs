@@ -87,6 +87,7 @@ struct RendererMeta {
     model: String,
     spp: u32,
     max_depth: u32,
+    split_depth: u32,
     seed: u64,
 }
 
@@ -200,6 +201,7 @@ fn meta<'a>(
             model: format!("{:?}", out.model),
             spp: out.spp,
             max_depth: s.settings.max_depth,
+            split_depth: s.settings.split_depth,
             seed: s.settings.seed,
         },
         sensor: SensorMeta {

@@ -72,6 +72,10 @@ fn into_frame(s: &Stokes, k: &Vec3, x: impl FnOnce() -> Vec3) -> Stokes {
 /// it mostly kills glass paths whose throughput is still near 1, adding variance.
 const RR_DEPTH: u32 = 5;
 
+/// The deepest `split_depth` (see [`crate::RenderSettings`]): split paths stay
+/// above Russian roulette, which divides their share out.
+pub const MAX_SPLIT_DEPTH: u32 = RR_DEPTH;
+
 /// The power heuristic with exponent 2.
 fn power_heuristic(a: f64, b: f64) -> f64 {
     let (a2, b2) = (a * a, b * b);
@@ -580,7 +584,8 @@ impl<R: Transport> Path<R> {
         if let Some(u_light) = environment {
             light.environment(u_light, &u, sampler, sum);
         }
-        if depth == 0
+        if depth < world.scene.settings.split_depth
+            && (depth == 0 || vertex.is_delta())
             && let Some([first, second]) = vertex.lobe_outcomes([u[1], u[2]])
         {
             // Both outcomes of the choice (its number u[0] unused): the second goes
@@ -613,7 +618,7 @@ impl<R: Transport> Path<R> {
     }
 
     /// Continues along an outcome `s` of a split lobe choice, weighted by its
-    /// probability `p` (at the camera vertex, above Russian roulette's depth).
+    /// probability `p` (above Russian roulette's depth).
     #[inline(always)]
     fn follow_share(
         &mut self,
@@ -624,7 +629,7 @@ impl<R: Transport> Path<R> {
         sampler: &mut Sampler,
     ) {
         debug_assert!(self.depth < RR_DEPTH);
-        self.share = p;
+        self.share *= p;
         s.weight *= p;
         self.follow(vertex, s, to_path, sampler);
     }
@@ -700,16 +705,27 @@ impl<R: Transport> Path<R> {
 pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sampler) -> Stokes {
     let mut sum = Stokes::zeros();
     let mut path = Path::<R>::camera(world, d0);
-    // A path split off at the camera vertex, traced (with its own stream) after this one.
-    let mut pending = None;
+    // Paths split off, traced last in first out, each with its own stream. A path
+    // split off at depth d splits only deeper, so at most one per depth waits.
+    let mut pending: [Option<(Path<R>, Sampler)>; MAX_SPLIT_DEPTH as usize] =
+        [const { None }; MAX_SPLIT_DEPTH as usize];
+    let (mut waiting, mut splits) = (0, 0);
     loop {
         match path.step(world, d0, sampler, &mut sum) {
             Step::Continue => {}
-            Step::Split(other) => pending = Some((other, sampler.branch())),
-            Step::End => match pending.take() {
-                Some((other, stream)) => (path, *sampler) = (other, stream),
-                None => return sum,
-            },
+            Step::Split(other) => {
+                pending[waiting] = Some((other, sampler.branch(splits)));
+                (waiting, splits) = (waiting + 1, splits + 1);
+            }
+            Step::End => {
+                let Some(next) = waiting.checked_sub(1) else {
+                    return sum;
+                };
+                waiting = next;
+                if let Some((other, stream)) = pending[waiting].take() {
+                    (path, *sampler) = (other, stream);
+                }
+            }
         }
     }
 }

@@ -23,6 +23,7 @@ mod tracking;
 pub mod transport;
 mod world;
 
+pub use integrator::MAX_SPLIT_DEPTH;
 pub use medium::{DensityGrid, Medium};
 pub use polar_bsdf::{Material, Polarization};
 pub use render::{RenderOptions, RenderOutput, render, required_model};

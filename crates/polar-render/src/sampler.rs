@@ -70,9 +70,11 @@ const LOW_BITS_DOMAIN: u64 = 0x10e5_b175_0000_0000;
 const PATH_LOW_BITS_DOMAIN: u64 = 0x9a7b_b175_0000_0000;
 const BRANCH_DOMAIN: u64 = 0xb2a4_c400_0000_0000;
 
-/// Offset of a split path's aligned draws. A path makes at most 3 per vertex, so
-/// only a path past vertex 349,525 (Russian roulette ends paths long before)
-/// would share scramble seeds with its branch: correlated numbers, still unbiased.
+/// Spacing of the aligned draws of the paths split off one sample's path: split
+/// `n` draws from `(n + 1) · BRANCH_DRAWS` on. A path makes at most 3 draws per
+/// vertex, so only a path past vertex 349,525 (Russian roulette ends paths long
+/// before) would reach the next split's scramble seeds: correlated numbers, still
+/// unbiased.
 const BRANCH_DRAWS: u64 = 1 << 20;
 
 /// `sobol_burley` supports sample indices below 2^16; each further block of 2^16
@@ -222,16 +224,17 @@ impl Sampler {
         [u0, u1, self.path_or_free(point)]
     }
 
-    /// The stream of a second path split off this sample's path at its camera
-    /// vertex (both outcomes of a lobe choice, see the integrator): its aligned
-    /// draws continue this stream's under other scramble seeds (each still
-    /// stratified over the pixel's samples), its free numbers come from another
-    /// hash key, and it has no path point (its delta vertices choose with free
-    /// numbers), so that its numbers are independent of the first path's.
-    pub fn branch(&self) -> Sampler {
+    /// The stream of the `n`-th path split off this sample's path (both outcomes
+    /// of a lobe choice, see the integrator; `n` counts the sample's splits): its
+    /// aligned draws continue this stream's under other scramble seeds (each still
+    /// stratified over the pixel's samples, and apart from every other split's), its
+    /// free numbers come from another hash key, and it has no path point (its delta
+    /// vertices choose with free numbers), so that its numbers are independent of
+    /// the other paths'.
+    pub fn branch(&self, n: u64) -> Sampler {
         Sampler {
-            key: mix(self.key ^ BRANCH_DOMAIN),
-            draw: self.draw + BRANCH_DRAWS,
+            key: mix(self.key ^ BRANCH_DOMAIN.wrapping_add(n.wrapping_mul(GAMMA))),
+            draw: (n + 1) * BRANCH_DRAWS + self.draw % BRANCH_DRAWS,
             path_set: None,
             path_next: sobol_burley::NUM_DIMENSIONS,
             ..self.clone()
@@ -566,19 +569,46 @@ mod tests {
         };
         // Its padded draws are (0,10,2)-nets over the pixel's 1024 samples.
         let points: Vec<[f64; 2]> = (0..1 << 10)
-            .map(|i| after_camera(i).branch().next_2d())
+            .map(|i| after_camera(i).branch(0).next_2d())
             .collect();
         assert!(is_net(&points));
-        let (mut parent, mut branch) = (after_camera(3), after_camera(3).branch());
-        assert_eq!(after_camera(3).branch().next_3d(), branch.clone().next_3d());
+        let (mut parent, mut branch) = (after_camera(3), after_camera(3).branch(0));
+        assert_eq!(
+            after_camera(3).branch(0).next_3d(),
+            branch.clone().next_3d()
+        );
         assert_ne!(branch.next_3d(), parent.next_3d());
         assert_ne!(branch.next_free(), parent.next_free());
         // No path point: a delta vertex's choice is a free number.
-        let mut free = after_camera(3).branch();
+        let mut free = after_camera(3).branch(0);
         assert_eq!(
-            after_camera(3).branch().next_scatter(1, true, false)[0],
+            after_camera(3).branch(0).next_scatter(1, true, false)[0],
             free.next_free()
         );
+        // Later splits, of the parent one vertex on or of the branch itself, get
+        // other numbers than the first split and than each other.
+        let mut later = after_camera(3);
+        later.next_3d();
+        let splits = [
+            later.branch(1),
+            after_camera(3).branch(0).branch(1),
+            after_camera(3).branch(2),
+        ];
+        let first = (
+            after_camera(3).branch(0).next_3d(),
+            after_camera(3).branch(0).next_free(),
+        );
+        for (i, s) in splits.iter().enumerate() {
+            let numbers = (s.clone().next_3d(), s.clone().next_free());
+            assert_ne!(numbers, first, "split {i}");
+            for t in &splits[i + 1..] {
+                assert_ne!(
+                    numbers,
+                    (t.clone().next_3d(), t.clone().next_free()),
+                    "split {i}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! `S0` in the implicit frame `x = polar_optics::stokes_basis(k)` of the
 //! propagation direction `k` (as Mitsuba 3 does for its polarized emitters).
 
+use crate::integrator::MAX_SPLIT_DEPTH;
 use crate::medium::Medium;
 use crate::sampler::SamplerKind;
 use crate::{Error, Material};
@@ -44,6 +45,10 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Maximum number of scattering events on a path (1 = direct lighting only).
     pub max_depth: u32,
+    /// Vertices before this depth trace both outcomes of a lobe choice instead of
+    /// drawing one: the camera vertex of glass and plastic, and every smooth-glass
+    /// vertex (0 = never; at most [`MAX_SPLIT_DEPTH`], where Russian roulette starts).
+    pub split_depth: u32,
     /// Where the sample points come from (Owen-scrambled Sobol by default).
     pub sampler: SamplerKind,
 }
@@ -54,6 +59,7 @@ impl Default for RenderSettings {
             spp: 64,
             seed: 0,
             max_depth: 8,
+            split_depth: MAX_SPLIT_DEPTH,
             sampler: SamplerKind::Sobol,
         }
     }
@@ -281,6 +287,12 @@ impl Scene {
         }
         if self.settings.max_depth == 0 {
             return bad("render.max_depth".into(), "must be at least 1".into());
+        }
+        if self.settings.split_depth > MAX_SPLIT_DEPTH {
+            return bad(
+                "render.split_depth".into(),
+                format!("must be at most {MAX_SPLIT_DEPTH} (where Russian roulette starts)"),
+            );
         }
         for (name, m) in &self.materials {
             if let Err(polar_bsdf::Error::InvalidParameter { field, reason }) = m.validate() {

@@ -104,6 +104,8 @@ struct RenderDesc {
     seed: u64,
     #[serde(default = "default_max_depth")]
     max_depth: u32,
+    #[serde(default = "default_split_depth")]
+    split_depth: u32,
     #[serde(default)]
     sampler: SamplerKind,
 }
@@ -116,6 +118,10 @@ fn default_max_depth() -> u32 {
     RenderSettings::default().max_depth
 }
 
+fn default_split_depth() -> u32 {
+    RenderSettings::default().split_depth
+}
+
 impl Default for RenderDesc {
     fn default() -> Self {
         let s = RenderSettings::default();
@@ -123,6 +129,7 @@ impl Default for RenderDesc {
             spp: s.spp,
             seed: s.seed,
             max_depth: s.max_depth,
+            split_depth: s.split_depth,
             sampler: s.sampler,
         }
     }
@@ -262,6 +269,7 @@ fn build(desc: SceneFile, file: &Path, base: &Path) -> Result<Scene, Error> {
         spp: desc.render.spp,
         seed: desc.render.seed,
         max_depth: desc.render.max_depth,
+        split_depth: desc.render.split_depth,
         sampler: desc.render.sampler,
     };
     scene.sensor = desc.sensor;

@@ -45,6 +45,21 @@ fn sampler_key_is_read_and_checked() {
 }
 
 #[test]
+fn split_depth_is_read_and_checked() {
+    let default = parse("").unwrap().settings.split_depth;
+    assert_eq!(default, polar_render::MAX_SPLIT_DEPTH);
+    assert_eq!(
+        parse("[render]\nsplit_depth = 0\n")
+            .unwrap()
+            .settings
+            .split_depth,
+        0
+    );
+    let err = parse("[render]\nsplit_depth = 6\n").unwrap_err();
+    assert_names(err, "render.split_depth", "must be at most 5");
+}
+
+#[test]
 fn key_of_another_shape_type_is_rejected() {
     let err = parse("[[shapes]]\ntype = \"cube\"\nradius = 1.0\n").unwrap_err();
     assert_names(err, "shapes[0].radius", "not used by shape type");
