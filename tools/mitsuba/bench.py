@@ -232,7 +232,7 @@ def compare(curves, mitsuba, ours_key):
             if bound:
                 t_ours = time_bound(o_rows, metric, level)
             ratio = time_at(m_rows, metric, level) / t_ours if np.isfinite(level) else np.nan
-            levels.append({"spp": spp, "error": level, "ratio": float(ratio), "lower_bound": bound and np.isfinite(ratio)})
+            levels.append({"spp": spp, "error": level, "ratio": float(ratio), "lower_bound": bool(bound and np.isfinite(ratio))})
         out[metric] = levels
         if mitsuba.endswith("/independent") and ours_key.endswith("/independent"):
             out[f"fit_{metric}"] = (fit_c(m_rows, metric) / fit_c(o_rows, metric)) ** 2

@@ -1,8 +1,8 @@
 //! Unidirectional path tracing of Mueller/Stokes radiance with next-event
 //! estimation, multiple importance sampling (power heuristic, Veach 1997),
-//! Russian roulette and, at the camera vertex of glass and plastic, both outcomes
-//! of the lobe choice traced (see [`radiance`]), generic over the [`Transport`]
-//! representation.
+//! Russian roulette and, at the camera vertex of glass and plastic and at every
+//! smooth-glass vertex before Russian roulette, both outcomes of the lobe choice
+//! traced (see [`radiance`]), generic over the [`Transport`] representation.
 //!
 //! Frames: a camera path carries the throughput `T` together with a frame: `T`
 //! maps Stokes light arriving along the current ray (travelling along `-d`) in
@@ -466,8 +466,8 @@ struct Path<R> {
     /// Product of the squared relative indices crossed: η² of the current medium.
     eta2: f64,
     depth: u32,
-    /// The probability of this path's outcome of the camera vertex's lobe choice
-    /// when both outcomes are traced ([`Bsdf::lobe_outcomes`]), else 1: its
+    /// The product of the probabilities of this path's outcomes of the lobe choices
+    /// whose outcomes were all traced ([`Bsdf::lobe_outcomes`]), 1 without any: its
     /// throughput already holds it, Russian roulette divides it out.
     share: f64,
 }
@@ -497,8 +497,9 @@ impl<R: Transport> Path<R> {
     }
 
     /// Follows the ray to its next vertex, adds what is emitted there and what
-    /// light sampling brings, and samples the continuation (at the camera vertex
-    /// of glass and plastic: both outcomes of the lobe choice, the first split off).
+    /// light sampling brings, and samples the continuation (above `split_depth`, at
+    /// the camera vertex of glass and plastic and at smooth glass: both outcomes of
+    /// the lobe choice, the first split off).
     #[inline(always)]
     fn step(
         &mut self,
@@ -679,17 +680,23 @@ impl<R: Transport> Path<R> {
 /// One path sample along the primary direction `d0`: the Stokes vector arriving
 /// at the camera, in the per-pixel camera frame (`film_frame(d0)`).
 ///
-/// At the camera vertex of glass (smooth) and plastic both outcomes of the lobe
-/// choice are traced, each weighted by its probability ([`Bsdf::lobe_outcomes`];
-/// branched path tracing at the first hit): the expectation over the choice
-/// instead of a draw, for one more path. The front reflection carries most of
-/// glass's polarization and plastic's two lobes polarize at right angles, so the
-/// draw was most of their polarization noise. Cross-check scenes at 256 spp
-/// against the bench references, one thread, CPU time: glass polarization error
-/// 0.415 % → 0.207 %, S0 0.106 % → 0.072 %, for 1.35× the time; pplastic
-/// polarization 0.063 % → 0.027 %, S0 0.139 % → 0.087 %, for 1.45× the time.
-/// The first outcome's path is traced after the second's, with its own stream
-/// ([`Sampler::branch`]).
+/// Above `split_depth` (default 5, where Russian roulette starts) both outcomes of
+/// a lobe choice are traced, each weighted by its probability
+/// ([`Bsdf::lobe_outcomes`]; branched path tracing): at the camera vertex of glass
+/// (smooth) and plastic, and at every smooth-glass vertex, where a split costs only
+/// ray segments (no light sampling at delta vertices). The expectation over the
+/// choice instead of a draw: the front reflection carries most of glass's
+/// polarization, the paths inside a glass object polarize differently with each
+/// internal reflection, and plastic's two lobes polarize at right angles, so the
+/// draws were most of their polarization noise. Cross-check scenes at 256 spp:
+/// splitting the camera vertex (against the bench references, one thread, CPU
+/// time) took glass's polarization error 0.415 % → 0.207 %, S0 0.106 % → 0.072 %,
+/// for 1.35× the time, pplastic's 0.063 % → 0.027 % and 0.139 % → 0.087 %, for
+/// 1.45×; splitting glass down to depth 5 (standard deviation between two seeds
+/// over the sphere, 2 threads) polarization 0.213 % → 0.0127 %, S0 0.074 % →
+/// 0.016 %, for 2.9× the time (split_depth 1 to 5: 0.213, 0.121, 0.046, 0.024,
+/// 0.0127 %, for 1, 1.5, 2.0, 2.5, 2.9× the time). A split-off path is traced after
+/// the one it split from, with its own stream ([`Sampler::branch`]).
 ///
 /// Work skipped without changing a bit of the result: the film frame is only
 /// computed when something polarized or a vertex needs it (a primary ray that
@@ -702,31 +709,40 @@ impl<R: Transport> Path<R> {
 /// update twice); the state passed by value or the loop re-entered with locals,
 /// 5–8 % more.
 #[inline(always)]
-pub(crate) fn radiance<R: Transport>(world: &World, d0: &Vec3, sampler: &mut Sampler) -> Stokes {
+pub(crate) fn radiance<R: Transport>(
+    world: &World,
+    d0: &Vec3,
+    sampler: &mut Sampler,
+    waiting: &mut SplitPaths<R>,
+) -> Stokes {
+    debug_assert!(waiting.0.is_empty());
     let mut sum = Stokes::zeros();
     let mut path = Path::<R>::camera(world, d0);
-    // Paths split off, traced last in first out, each with its own stream. A path
-    // split off at depth d splits only deeper, so at most one per depth waits.
-    let mut pending: [Option<(Path<R>, Sampler)>; MAX_SPLIT_DEPTH as usize] =
-        [const { None }; MAX_SPLIT_DEPTH as usize];
-    let (mut waiting, mut splits) = (0, 0);
+    let mut splits = 0;
     loop {
         match path.step(world, d0, sampler, &mut sum) {
             Step::Continue => {}
             Step::Split(other) => {
-                pending[waiting] = Some((other, sampler.branch(splits)));
-                (waiting, splits) = (waiting + 1, splits + 1);
+                waiting.0.push((other, sampler.branch(splits)));
+                splits += 1;
             }
-            Step::End => {
-                let Some(next) = waiting.checked_sub(1) else {
-                    return sum;
-                };
-                waiting = next;
-                if let Some((other, stream)) = pending[waiting].take() {
-                    (path, *sampler) = (other, stream);
-                }
-            }
+            Step::End => match waiting.0.pop() {
+                Some((other, stream)) => (path, *sampler) = (other, stream),
+                None => return sum,
+            },
         }
+    }
+}
+
+/// Paths split off and waiting to be traced, last in first out, each with its own
+/// stream. A path split off at depth d splits only deeper, so at most one per
+/// depth above `split_depth` waits. The caller keeps it across samples: as a
+/// fresh array per sample it cost 340 instructions per sample (callgrind).
+pub(crate) struct SplitPaths<R>(Vec<(Path<R>, Sampler)>);
+
+impl<R> SplitPaths<R> {
+    pub(crate) fn new() -> Self {
+        Self(Vec::with_capacity(MAX_SPLIT_DEPTH as usize))
     }
 }
 

@@ -2,7 +2,7 @@
 //! (Stokes in the per-pixel camera frame) and the first-hit ground truth.
 
 use crate::Error;
-use crate::integrator::radiance;
+use crate::integrator::{SplitPaths, radiance};
 use crate::sampler::PixelStreams;
 use crate::scene::Scene;
 use crate::transport::{Full, Linear, Scalar, Transport, emission_polarization};
@@ -262,13 +262,14 @@ fn pixel_sum<R: Transport>(world: &World, x: usize, y: usize) -> Stokes {
         (d, sampler)
     };
     let mut sum = Stokes::zeros();
+    let mut waiting = SplitPaths::new();
     let (mut d, mut sampler) = primary(0);
     for s in 1..settings.spp {
         let next = primary(s);
-        sum += radiance::<R>(world, &d, &mut sampler);
+        sum += radiance::<R>(world, &d, &mut sampler, &mut waiting);
         (d, sampler) = next;
     }
-    sum + radiance::<R>(world, &d, &mut sampler)
+    sum + radiance::<R>(world, &d, &mut sampler, &mut waiting)
 }
 
 /// First-hit ground truth along the ray through the pixel centre.

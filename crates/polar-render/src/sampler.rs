@@ -211,8 +211,10 @@ impl Sampler {
     /// vertices keep a padded 3-D draw, whose choice and 2-D point are stratified
     /// together. Numbers not used take the place of free ones but are not
     /// computed (NaN, see `path_or_free`); where the integrator traces both
-    /// outcomes of the first vertex's choice (glass, plastic), `u[0]` is drawn and
-    /// not used. Measured: see the module documentation.
+    /// outcomes of a choice (the camera vertex of glass and plastic, smooth glass
+    /// above `split_depth`), `u[0]` is drawn and not used, so with the default
+    /// split depth the path point chooses only at glass vertices from depth 5 on.
+    /// Measured: see the module documentation.
     #[inline(always)]
     pub fn next_scatter(&mut self, depth: u32, choice: bool, point: bool) -> [f64; 3] {
         if self.kind == SamplerKind::Independent || (depth > 0 && point) {
