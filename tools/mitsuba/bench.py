@@ -33,7 +33,7 @@ ratios are printed for both clocks: wall time is the measure on an idle
 machine, CPU time the one a loaded machine distorts less (README.md).
 
     tools/.venv/bin/python tools/mitsuba/bench.py OUT [--refs DIR] [--threads 2]
-        [--spp 16,64,256,1024] [--scenes a,b] [--mitsuba-samplers a,b|all]
+        [--spp 1,4,16,64,256,1024] [--scenes a,b] [--mitsuba-samplers a,b|all]
         [--mitsuba-only] [--ours-exe PATH] [--ours-only-if-available]
 
 Writes OUT/bench.json, OUT/bench.png (error vs time, S0 and polarization)
@@ -85,8 +85,8 @@ def parse_args():
     ap.add_argument("--refs", type=Path, default=None,
                     help="reference cache (default: OUT/refs); bench references go to REFS/bench")
     ap.add_argument("--threads", type=int, default=2, help="threads for both renderers (default 2)")
-    ap.add_argument("--spp", type=lambda t: [int(v) for v in t.split(",")], default=[16, 64, 256, 1024],
-                    help="comma-separated spp values for both renderers (include 64, 256, 1024: the comparison levels)")
+    ap.add_argument("--spp", type=lambda t: [int(v) for v in t.split(",")], default=[1, 4, 16, 64, 256, 1024],
+                    help="comma-separated spp values for both renderers (include 64, 256, 1024: the comparison levels; low ones let a faster curve start above them)")
     ap.add_argument("--scenes", type=render_refs.parse_scene_list, default=scenes.SCENES)
     ap.add_argument("--mitsuba-samplers", type=parse_samplers, default=None,
                     help=f"Mitsuba samplers to time (default: independent,{MITSUBA_LD}; all: every one)")
