@@ -193,8 +193,7 @@ impl Vertex<'_> {
     /// this vertex, whose own sampling has density `pdf` for it (the density of
     /// [`Self::cosine_environment`], or `pdf`).
     fn environment_density(&self, wi: &Vec3, pdf: f64) -> f64 {
-        self.cosine_environment()
-            .map_or(pdf, |n| n.dot(wi).max(0.0) / PI)
+        self.cosine_environment().map_or(pdf, |n| cosine_pdf(n, wi))
     }
 
     /// No light sampling at a vertex whose every lobe is a delta.
@@ -362,7 +361,7 @@ impl<R: Transport, P: Fn(&Mueller) -> R> NextEvent<'_, '_, R, P> {
         let (wi, f, in_x, pdf, w) = match self.vertex.cosine_environment() {
             Some(n) => {
                 let wi = cosine_direction(n, u_light);
-                let pdf = self.world.environment_pdf(n.dot(&wi).max(0.0) / PI);
+                let pdf = self.world.environment_pdf(cosine_pdf(n, &wi));
                 if pdf <= 0.0 {
                     return;
                 }
@@ -445,6 +444,11 @@ fn cosine_direction(n: &Vec3, u: [f64; 2]) -> Vec3 {
     let x = stokes_basis(n);
     let y = n.cross(&x);
     x * (r * phi.cos()) + y * (r * phi.sin()) + n * (1.0 - u[0]).max(0.0).sqrt()
+}
+
+/// Density of [`cosine_direction`] about `n`: `max(n · wi, 0) / π`.
+fn cosine_pdf(n: &Vec3, wi: &Vec3) -> f64 {
+    n.dot(wi).max(0.0) / PI
 }
 
 /// `sum += t · le · w`, with `t = None` the identity (exactly: `I · le = le`).

@@ -191,7 +191,8 @@ impl<'a> World<'a> {
     }
 
     /// Density (solid angle, with the light choice) with which light sampling reaches
-    /// the environment in a direction its directions have density `density` for.
+    /// the environment in a direction that the integrator's environment sampling
+    /// draws with density `density`.
     pub fn environment_pdf(&self, density: f64) -> f64 {
         self.pick_probability() * density
     }

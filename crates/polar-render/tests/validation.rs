@@ -52,6 +52,22 @@ fn sphere_cos(o: &V3, d: &V3) -> Option<f64> {
     })
 }
 
+/// Cosines of incidence on the unit sphere of an `n × n` grid of sub-pixel rays of
+/// pixel `(x, y)` (camera `cam`), if every ray meets the sphere at a cosine of at
+/// least 0.3 (steeper footprints vary too much within the pixel to predict).
+fn footprint_cosines(cam: &Camera, x: usize, y: usize, n: usize) -> Option<Vec<f64>> {
+    (0..n * n)
+        .map(|k| {
+            let (sx, sy) = (
+                (0.5 + (k % n) as f64) / n as f64,
+                (0.5 + (k / n) as f64) / n as f64,
+            );
+            sphere_cos(&cam.position, &ray_dir(cam, x as f64 + sx, y as f64 + sy))
+                .filter(|c| *c >= 0.3)
+        })
+        .collect()
+}
+
 #[test]
 fn white_furnace_lambertian_sphere_is_invisible() {
     // Albedo-1 Lambertian sphere in a uniform environment of radiance 1: every pixel has S0 = 1.
@@ -87,7 +103,6 @@ fn specular_sphere_dolp_and_aolp_follow_fresnel() {
     scene.settings.spp = 64;
     let out = run(&scene);
     assert_eq!(out.model, polar_render::Polarization::Linear);
-    let o = cam.position;
     let (mut worst_dolp, mut worst_aolp, mut max_dolp, mut checked) =
         (0.0_f64, 0.0_f64, 0.0_f64, 0);
     let (mut sum_err, mut sum_abs) = (0.0, 0.0);
@@ -95,22 +110,12 @@ fn specular_sphere_dolp_and_aolp_follow_fresnel() {
         for x in 0..cam.width {
             // Prediction: mean Stokes over an 8x8 grid of sub-pixel rays; pixels whose footprint
             // is not wholly on the sphere are skipped.
-            let grid = (0..64).map(|k| {
-                ray_dir(
-                    &cam,
-                    x as f64 + (0.5 + (k % 8) as f64) / 8.0,
-                    y as f64 + (0.5 + (k / 8) as f64) / 8.0,
-                )
-            });
-            let cosines: Option<Vec<(V3, f64)>> =
-                grid.map(|d| sphere_cos(&o, &d).map(|c| (d, c))).collect();
-            let Some(cosines) = cosines else { continue };
-            if cosines.iter().any(|(_, c)| *c < 0.3) {
+            let Some(cosines) = footprint_cosines(&cam, x, y, 8) else {
                 continue;
-            }
+            };
             let s = out.stokes.pixel(x, y).map(f64::from);
             let mut pred = [0.0; 2];
-            for (_, c) in &cosines {
+            for c in &cosines {
                 let (rs, rp) =
                     polar_optics::fresnel_amplitudes(*c, num_complex::Complex64::new(1.5, 0.0))
                         .reflectance();
@@ -324,7 +329,6 @@ fn constant_environment_on_smooth_lobes_matches_quadrature() {
         }),
     ];
     let cam = camera(20.0, 6.5, 32);
-    let o = cam.position;
     for material in materials {
         // The reflectance on 24 viewing angles, interpolated linearly in cos θo.
         let cos_table: Vec<f64> = (0..24).map(|i| 0.25 + 0.75 * i as f64 / 23.0).collect();
@@ -347,14 +351,9 @@ fn constant_environment_on_smooth_lobes_matches_quadrature() {
             for x in 0..cam.width {
                 // The pixel's prediction: the mean over a 4x4 grid of sub-pixel rays, all on the
                 // sphere with cos θo >= 0.3.
-                let cosines: Option<Vec<f64>> = (0..16)
-                    .map(|k| {
-                        let (sx, sy) = ((0.5 + (k % 4) as f64) / 4.0, (0.5 + (k / 4) as f64) / 4.0);
-                        sphere_cos(&o, &ray_dir(&cam, x as f64 + sx, y as f64 + sy))
-                            .filter(|c| *c >= 0.3)
-                    })
-                    .collect();
-                let Some(cosines) = cosines else { continue };
+                let Some(cosines) = footprint_cosines(&cam, x, y, 4) else {
+                    continue;
+                };
                 let (s0, pol) = cosines.iter().fold((0.0, 0.0), |(s, p), &c| {
                     let (a, b) = predict(c);
                     (s + a / 16.0, p + b / 16.0)
@@ -400,21 +399,15 @@ fn glass_sphere_is_traced_exactly_before_russian_roulette() {
     scene.settings.spp = 16;
     scene.settings.max_depth = 5;
     let out = run(&scene);
-    let o = cam.position;
     let brings = |r: f64| r + (1.0 - r).powi(2) * (1.0 + r + r * r + r * r * r);
     let (mut checked, mut worst_s0, mut worst_dolp) = (0, 0.0_f64, 0.0_f64);
     for y in 0..cam.height {
         for x in 0..cam.width {
             // The pixel's prediction: the mean over an 8x8 grid of sub-pixel rays, all on the
-            // sphere with cos > 0.3.
-            let cosines: Option<Vec<f64>> = (0..64)
-                .map(|k| {
-                    let (sx, sy) = ((0.5 + (k % 8) as f64) / 8.0, (0.5 + (k / 8) as f64) / 8.0);
-                    sphere_cos(&o, &ray_dir(&cam, x as f64 + sx, y as f64 + sy))
-                        .filter(|c| *c > 0.3)
-                })
-                .collect();
-            let Some(cosines) = cosines else { continue };
+            // sphere with cos >= 0.3.
+            let Some(cosines) = footprint_cosines(&cam, x, y, 8) else {
+                continue;
+            };
             let (mut s, mut p) = (0.0, 0.0);
             for c in &cosines {
                 let (rs, rp) =
