@@ -21,9 +21,6 @@ pub enum Error {
         /// What is wrong and where.
         message: String,
     },
-    /// A `--shard` argument that is not `K/N` with `1 <= K <= N`.
-    #[error("bad shard '{0}': expected K/N with 1 <= K <= N, e.g. --shard 2/8")]
-    Shard(String),
     /// The output directory cannot be created or written.
     #[error("output directory {path} is not writable: {source}")]
     OutputNotWritable {

@@ -4,58 +4,18 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 use std::sync::Mutex;
 use std::time::Instant;
 
 use rayon::prelude::*;
+
+pub use polar_io::Shard;
 
 use crate::Error;
 use crate::params::{SampleParams, draw_params};
 use crate::progress::Progress;
 use crate::store::{self, ManifestEntry, RunRecord, Timings};
 use crate::suite::{SizeName, Suite};
-
-/// Shard `k` of `n` (1-based): it owns the samples whose global index i has i mod n = k - 1,
-/// so costly and cheap families spread evenly over the shards.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Shard {
-    /// This shard, 1..=n.
-    pub k: u32,
-    /// Number of shards.
-    pub n: u32,
-}
-
-impl Shard {
-    /// The whole dataset as one shard.
-    pub const ALL: Shard = Shard { k: 1, n: 1 };
-
-    /// Whether this shard owns the sample with global index `i`.
-    pub fn owns(self, i: usize) -> bool {
-        i % self.n as usize == (self.k - 1) as usize
-    }
-}
-
-impl FromStr for Shard {
-    type Err = Error;
-
-    fn from_str(s: &str) -> Result<Shard, Error> {
-        let bad = || Error::Shard(s.to_owned());
-        let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let k: u32 = k.trim().parse().map_err(|_| bad())?;
-        let n: u32 = n.trim().parse().map_err(|_| bad())?;
-        if k == 0 || n == 0 || k > n {
-            return Err(bad());
-        }
-        Ok(Shard { k, n })
-    }
-}
-
-impl std::fmt::Display for Shard {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.k, self.n)
-    }
-}
 
 /// What the per-sample work reports back to the runner.
 #[derive(Clone, Debug, PartialEq)]

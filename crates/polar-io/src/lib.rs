@@ -11,6 +11,7 @@ mod error;
 mod openexr;
 mod png;
 mod sample;
+mod shard;
 mod validate;
 
 pub use error::{Error, Result};
@@ -22,9 +23,10 @@ pub use png::{
     read_rgb8_png, write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png,
 };
 pub use sample::{
-    GroundTruth, Sample, TRANSPARENT_MASK_ON, files, material, read_json, read_sample,
-    read_sample_with, write_json, write_sample,
+    GroundTruth, Sample, TRANSPARENT_MASK_ON, files, material, read_ground_truth, read_json,
+    read_optional_meta, read_sample, read_sample_with, write_json, write_sample,
 };
+pub use shard::{Shard, ShardError};
 pub use validate::{Rule, Validation, check_channels, check_stokes, check_u8};
 
 /// Channel names of a full Stokes EXR (`stokes.exr`).

@@ -37,6 +37,42 @@ pub mod files {
     /// Float32 Y in `[0, 1]`: transmittance of the medium along each pixel's central ray to
     /// the first surface (an addition of this project, for dehazing).
     pub const GT_TRANSMISSION: &str = "gt/transmission.exr";
+
+    /// What `polar-vision` writes into its output directory (docs/conventions.md).
+    pub mod vision {
+        /// Float32 S0, S1, S2 (S3 where known).
+        pub const STOKES: &str = "stokes.exr";
+        /// Float32 Y: degree of linear polarization.
+        pub const DOLP: &str = "dolp.exr";
+        /// Float32 Y: angle of linear polarization, radians in `[0, π)`.
+        pub const AOLP: &str = "aolp.exr";
+        /// Float32 R, G, B: unit camera-frame normals (shape from polarization).
+        pub const NORMAL: &str = "normal.exr";
+        /// Float32 Y: relative depth from the normals.
+        pub const DEPTH: &str = "depth.exr";
+        /// Float32 Y: per-pixel confidence in `[0, 1]` of the normals.
+        pub const NORMAL_CONFIDENCE: &str = "normal_confidence.exr";
+        /// 8-bit reflection type per pixel: 0 none, 1 diffuse, 2 specular, 3 mixed.
+        pub const REFLECTION: &str = "reflection.png";
+        /// 8-bit material labels as `gt/material.png`.
+        pub const MATERIAL: &str = "material.png";
+        /// Float32 Y: confidence of the material label in `[0, 1]`.
+        pub const MATERIAL_CONFIDENCE: &str = "material_confidence.exr";
+        /// 8-bit mask as `gt/transparent.png`.
+        pub const TRANSPARENT: &str = "transparent.png";
+        /// Float32 Y: transparency score in `[0, 1]`.
+        pub const TRANSPARENT_SCORE: &str = "transparent_score.exr";
+        /// Float32 Y: dehazed radiance.
+        pub const DEHAZED: &str = "dehazed.exr";
+        /// Float32 Y: estimated transmission in `(0, 1]`.
+        pub const TRANSMISSION: &str = "transmission.exr";
+        /// Float32 Y: relative depth `−ln t` from the transmission.
+        pub const HAZE_DEPTH: &str = "haze_depth.exr";
+        /// Per-task status, timings and (with ground truth) metrics.
+        pub const METRICS: &str = "metrics.json";
+        /// Folder of 8-bit pictures for people.
+        pub const PICTURES: &str = "pictures";
+    }
 }
 
 /// Labels of `gt/material.png`.
@@ -108,27 +144,51 @@ pub fn read_sample_with(dir: impl AsRef<Path>, validation: Validation) -> Result
         stokes: opt(files::STOKES)?
             .map(|p| read_exr(p, STOKES_CHANNELS))
             .transpose()?,
-        gt: GroundTruth {
-            normal: opt(files::GT_NORMAL)?
-                .map(|p| read_exr(p, RGB_CHANNELS))
-                .transpose()?,
-            depth: opt(files::GT_DEPTH)?
-                .map(|p| read_exr(p, Y_CHANNEL))
-                .transpose()?,
-            material: opt(files::GT_MATERIAL)?.map(read_gray8_png).transpose()?,
-            transparent: opt(files::GT_TRANSPARENT)?
-                .map(read_gray8_png)
-                .transpose()?,
-            clear: opt(files::GT_CLEAR)?
-                .map(|p| read_exr(p, Y_CHANNEL))
-                .transpose()?,
-            transmission: opt(files::GT_TRANSMISSION)?
-                .map(|p| read_exr(p, Y_CHANNEL))
-                .transpose()?,
-        },
+        gt: read_gt_files(dir)?,
     };
     check_sample(dir, &sample, validation)?;
     Ok(sample)
+}
+
+/// Reads the ground truth of a sample directory (`gt/`; each file optional), with the
+/// checks of [`read_sample_with`] on what is there; `meta.json` is not needed.
+pub fn read_ground_truth(dir: impl AsRef<Path>, validation: Validation) -> Result<GroundTruth> {
+    let dir = dir.as_ref();
+    let sample = Sample {
+        gt: read_gt_files(dir)?,
+        ..Sample::default()
+    };
+    check_sample(dir, &sample, validation)?;
+    Ok(sample.gt)
+}
+
+/// `meta.json` of a sample directory if it has one (a JSON object).
+pub fn read_optional_meta(dir: impl AsRef<Path>) -> Result<Option<Map<String, Value>>> {
+    optional(dir.as_ref().join(files::META))?
+        .map(|p| read_meta(&p))
+        .transpose()
+}
+
+fn read_gt_files(dir: &Path) -> Result<GroundTruth> {
+    let opt = |name: &str| optional(dir.join(name));
+    Ok(GroundTruth {
+        normal: opt(files::GT_NORMAL)?
+            .map(|p| read_exr(p, RGB_CHANNELS))
+            .transpose()?,
+        depth: opt(files::GT_DEPTH)?
+            .map(|p| read_exr(p, Y_CHANNEL))
+            .transpose()?,
+        material: opt(files::GT_MATERIAL)?.map(read_gray8_png).transpose()?,
+        transparent: opt(files::GT_TRANSPARENT)?
+            .map(read_gray8_png)
+            .transpose()?,
+        clear: opt(files::GT_CLEAR)?
+            .map(|p| read_exr(p, Y_CHANNEL))
+            .transpose()?,
+        transmission: opt(files::GT_TRANSMISSION)?
+            .map(|p| read_exr(p, Y_CHANNEL))
+            .transpose()?,
+    })
 }
 
 /// Writes `sample` as the directory `dir` (parents are created), after the checks of

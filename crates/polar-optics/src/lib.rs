@@ -28,6 +28,7 @@ pub mod error;
 pub mod frame;
 pub mod fresnel;
 pub mod mueller;
+pub mod pixel_frame;
 pub mod scatter;
 pub mod sky;
 pub mod stokes;

@@ -15,12 +15,14 @@ pub mod demosaic;
 pub mod fastmath;
 pub mod layout;
 pub mod mask;
+pub mod observation;
 pub mod picture;
 pub mod products;
 pub mod sensor;
 
 pub use demosaic::{DemosaicMethod, demosaic};
 pub use layout::{Mosaic, MosaicSample};
+pub use observation::Observation;
 pub use products::{StokesPlanes, stokes_planes, stokes_planes_from_angles};
 pub use sensor::{SensorModel, SensorOutput};
 

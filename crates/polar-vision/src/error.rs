@@ -71,4 +71,72 @@ pub enum CliError {
         /// Significant bits.
         bits: u8,
     },
+    /// `--input` names a file the sample directory does not have.
+    #[error("{dir}: has no {file} (asked for by --input)")]
+    MissingSource {
+        /// The sample directory.
+        dir: PathBuf,
+        /// The missing file.
+        file: &'static str,
+    },
+    /// Ground truth of another size than the input.
+    #[error("{sample}: the input is {}x{} but its ground truth is {}x{} (a half-resolution demosaicing such as superpixel cannot be scored)", input.0, input.1, gt.0, gt.1)]
+    GtSize {
+        /// The sample.
+        sample: PathBuf,
+        /// Input size.
+        input: (usize, usize),
+        /// Ground-truth size.
+        gt: (usize, usize),
+    },
+    /// A folder holds no sample directories.
+    #[error("{0}: no sample directories (sub-folders with raw.png or stokes.exr) found")]
+    NoSamples(PathBuf),
+    /// Shards evaluated with different options cannot be merged.
+    #[error("{0}: evaluated with other options than the first shard; cannot merge")]
+    MergeOptions(PathBuf),
+    /// A file or folder could not be read or written.
+    #[error("{path}: {action}: {reason}")]
+    File {
+        /// The path.
+        path: PathBuf,
+        /// `cannot read` or `cannot write`.
+        action: &'static str,
+        /// The system's reason.
+        reason: String,
+    },
+    /// The worker thread pool could not be made.
+    #[error("cannot start worker threads: {0}")]
+    Threads(String),
+    /// Metrics could not be serialized.
+    #[error("cannot serialize metrics: {0}")]
+    Json(String),
+    /// A task's library reported an error on valid input (a bug to report).
+    #[error("{task}: {message}")]
+    Task {
+        /// The task.
+        task: &'static str,
+        /// Its error.
+        message: String,
+    },
+}
+
+impl CliError {
+    /// A read failure of `path`.
+    pub fn read(path: impl Into<PathBuf>, e: std::io::Error) -> Self {
+        CliError::File {
+            path: path.into(),
+            action: "cannot read",
+            reason: e.to_string(),
+        }
+    }
+
+    /// A write failure of `path`.
+    pub fn write(path: impl Into<PathBuf>, e: std::io::Error) -> Self {
+        CliError::File {
+            path: path.into(),
+            action: "cannot write",
+            reason: e.to_string(),
+        }
+    }
 }

@@ -1,0 +1,335 @@
+//! One metrics function per task.
+
+use std::collections::BTreeMap;
+
+use polar_image::{Gray, Image};
+use polar_imgproc::{AngularErrorStats, ConfusionMatrix, angular_error, psnr, ssim};
+use serde::{Deserialize, Serialize};
+
+use crate::depth::{DepthFit, depth_fit};
+use crate::{EvalError, check_size};
+
+/// Normal-map accuracy: angles in degrees between estimated and true normals.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NormalMetrics {
+    /// Pixels scored.
+    pub count: usize,
+    /// Mean angle.
+    pub mean_deg: f64,
+    /// Median angle.
+    pub median_deg: f64,
+    /// Root mean square angle.
+    pub rmse_deg: f64,
+    /// Percentage of pixels below 11.25°.
+    pub pct_below_11_25: f64,
+    /// Percentage below 22.5°.
+    pub pct_below_22_5: f64,
+    /// Percentage below 30°.
+    pub pct_below_30: f64,
+    /// Mean angle per estimated reflection type (by name), where the estimate gives one.
+    pub mean_deg_by_type: BTreeMap<String, f64>,
+    /// Depth after the best scale-and-offset fit, where depth was estimated.
+    pub depth: Option<DepthFit>,
+}
+
+impl NormalMetrics {
+    fn from_stats(s: AngularErrorStats) -> Self {
+        Self {
+            count: s.count,
+            mean_deg: s.mean,
+            median_deg: s.median,
+            rmse_deg: s.rmse,
+            pct_below_11_25: s.pct_below_11_25,
+            pct_below_22_5: s.pct_below_22_5,
+            pct_below_30: s.pct_below_30,
+            mean_deg_by_type: BTreeMap::new(),
+            depth: None,
+        }
+    }
+}
+
+/// Normal accuracy over `objects` (non-zero = scored); with `types` (a per-pixel class and
+/// its names, index = value) also per class, and with depths the fitted depth error.
+pub fn normal_metrics(
+    est: &Image<f32, 3>,
+    truth: &Image<f32, 3>,
+    objects: &Gray<u8>,
+    types: Option<(&Gray<u8>, &[&str])>,
+    depth: Option<(&Gray<f32>, &Gray<f32>)>,
+) -> Result<Option<NormalMetrics>, EvalError> {
+    check_size("normals", est.size(), truth.size())?;
+    check_size("object mask", objects.size(), truth.size())?;
+    let Some(stats) = angular_error(est, truth, Some(objects))? else {
+        return Ok(None);
+    };
+    let mut out = NormalMetrics::from_stats(stats);
+    if let Some((classes, names)) = types {
+        check_size("reflection types", classes.size(), truth.size())?;
+        for (value, name) in names.iter().enumerate() {
+            let mask = select(objects, |k| usize::from(classes.as_slice()[k]) == value);
+            if let Some(s) = angular_error(est, truth, Some(&mask))? {
+                out.mean_deg_by_type.insert((*name).to_owned(), s.mean);
+            }
+        }
+    }
+    if let Some((est_depth, gt_depth)) = depth {
+        out.depth = depth_fit(est_depth, gt_depth, objects)?;
+    }
+    Ok(Some(out))
+}
+
+/// `objects` restricted to the pixels where `keep(k)` holds.
+fn select(objects: &Gray<u8>, keep: impl Fn(usize) -> bool) -> Gray<u8> {
+    let mut m = objects.clone();
+    for (k, v) in m.as_mut_slice().iter_mut().enumerate() {
+        *v = u8::from(*v != 0 && keep(k));
+    }
+    m
+}
+
+/// Material labels (0 background, 1 dielectric, 2 metal, 3 transparent) against truth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MaterialMetrics {
+    /// Pixels whose true label is 1 or 2 and whose prediction is 1 or 2.
+    pub foreground_pixels: u64,
+    /// Metal against dielectric: the fraction of those pixels labelled correctly.
+    pub metal_vs_dielectric_accuracy: Option<f64>,
+    /// Fraction of all pixels labelled correctly (four classes).
+    pub pixel_accuracy: Option<f64>,
+    /// IoU per class (index = label), `None` where the class is in neither image.
+    pub class_iou: Vec<Option<f64>>,
+    /// Rows = truth, columns = prediction, labels 0..=3.
+    pub confusion: Vec<Vec<u64>>,
+}
+
+/// Scores a material map (labels 0..=3) against `gt/material.png`.
+pub fn material_metrics(pred: &Gray<u8>, truth: &Gray<u8>) -> Result<MaterialMetrics, EvalError> {
+    check_size("material labels", pred.size(), truth.size())?;
+    let cm = ConfusionMatrix::from_labels(truth, pred, 4)?;
+    let (right, fg) = [(1, 1), (2, 2), (1, 2), (2, 1)]
+        .iter()
+        .fold((0, 0), |(r, n), &(t, p)| {
+            let c = cm.count(t, p);
+            (r + if t == p { c } else { 0 }, n + c)
+        });
+    Ok(MaterialMetrics {
+        foreground_pixels: fg,
+        metal_vs_dielectric_accuracy: (fg > 0).then(|| right as f64 / fg as f64),
+        pixel_accuracy: cm.accuracy(),
+        class_iou: (0..4).map(|c| cm.class_iou(c)).collect(),
+        confusion: (0..4)
+            .map(|t| (0..4).map(|p| cm.count(t, p)).collect())
+            .collect(),
+    })
+}
+
+/// A binary mask (non-zero = inside) against its truth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MaskMetrics {
+    /// `|P ∩ T| / |P ∪ T|`; `None` when both are empty.
+    pub iou: Option<f64>,
+    /// `|P ∩ T| / |P|`; `None` when nothing is predicted.
+    pub precision: Option<f64>,
+    /// `|P ∩ T| / |T|`; `None` when the truth is empty.
+    pub recall: Option<f64>,
+    /// Fraction of the distractor pixels (e.g. opaque shiny objects) predicted inside.
+    pub false_positive_on_distractors: Option<f64>,
+}
+
+/// Scores a mask; `distractors` (non-zero = a pixel that must stay outside, e.g. metal and
+/// dielectric objects of `gt/material.png`) gives the false-positive fraction on them.
+pub fn mask_metrics(
+    pred: &Gray<u8>,
+    truth: &Gray<u8>,
+    distractors: Option<&Gray<u8>>,
+) -> Result<MaskMetrics, EvalError> {
+    check_size("mask", pred.size(), truth.size())?;
+    let (p, t) = (pred.as_slice(), truth.as_slice());
+    let count = |f: &dyn Fn(usize) -> bool| (0..p.len()).filter(|&k| f(k)).count() as f64;
+    let inter = count(&|k| p[k] != 0 && t[k] != 0);
+    let (np, nt) = (count(&|k| p[k] != 0), count(&|k| t[k] != 0));
+    let union = np + nt - inter;
+    let fp = match distractors {
+        Some(d) => {
+            check_size("distractor mask", d.size(), truth.size())?;
+            let d = d.as_slice();
+            let nd = count(&|k| d[k] != 0);
+            (nd > 0.0).then(|| count(&|k| d[k] != 0 && p[k] != 0) / nd)
+        }
+        None => None,
+    };
+    let ratio = |a: f64, b: f64| (b > 0.0).then(|| a / b);
+    Ok(MaskMetrics {
+        iou: ratio(inter, union),
+        precision: ratio(inter, np),
+        recall: ratio(inter, nt),
+        false_positive_on_distractors: fp,
+    })
+}
+
+/// PSNR (dB) and SSIM of one image against a reference.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImageScore {
+    /// Peak signal-to-noise ratio with the reference's maximum as the data range.
+    pub psnr_db: f64,
+    /// Mean SSIM with the same data range.
+    pub ssim: f64,
+}
+
+/// Dehazing: the hazy input and the dehazed output, each against a clear reference, and
+/// the estimated transmission against the true one.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DehazeMetrics {
+    /// Hazy S0 against the reference.
+    pub hazy: ImageScore,
+    /// Dehazed radiance against the reference.
+    pub dehazed: ImageScore,
+    /// Mean absolute transmission error, where the truth is known.
+    pub transmission_mae: Option<f64>,
+    /// Pearson correlation of estimated and true transmission.
+    pub transmission_correlation: Option<f64>,
+}
+
+/// Scores a dehazing result over the whole frame. The data range of PSNR and SSIM is the
+/// reference's maximum (at least the smallest positive float), so a scale-free score.
+pub fn dehaze_metrics(
+    hazy: &Gray<f32>,
+    dehazed: &Gray<f32>,
+    reference: &Gray<f32>,
+    transmission: Option<(&Gray<f32>, &Gray<f32>)>,
+) -> Result<DehazeMetrics, EvalError> {
+    check_size("dehazed", dehazed.size(), reference.size())?;
+    check_size("hazy", hazy.size(), reference.size())?;
+    let range = reference
+        .as_slice()
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(f32::MIN_POSITIVE, f32::max) as f64;
+    let score = |img: &Gray<f32>| -> Result<ImageScore, EvalError> {
+        Ok(ImageScore {
+            psnr_db: psnr(reference, img, range)?,
+            ssim: ssim(reference, img, range)?,
+        })
+    };
+    let (mae, corr) = match transmission {
+        Some((est, gt)) => {
+            check_size("transmission", est.size(), gt.size())?;
+            let n = est.as_slice().len().max(1) as f64;
+            let mae = est
+                .as_slice()
+                .iter()
+                .zip(gt.as_slice())
+                .map(|(a, b)| f64::from((a - b).abs()))
+                .sum::<f64>()
+                / n;
+            (Some(mae), pearson(est.as_slice(), gt.as_slice()))
+        }
+        None => (None, None),
+    };
+    Ok(DehazeMetrics {
+        hazy: score(hazy)?,
+        dehazed: score(dehazed)?,
+        transmission_mae: mae,
+        transmission_correlation: corr,
+    })
+}
+
+/// Pearson correlation of two equally long series over the pairs where both are finite;
+/// `None` with fewer than 2 such pairs or a constant series.
+pub fn pearson(a: &[f32], b: &[f32]) -> Option<f64> {
+    let pairs: Vec<(f64, f64)> = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(&x, &y)| (f64::from(x), f64::from(y)))
+        .collect();
+    let n = pairs.len() as f64;
+    if pairs.len() < 2 {
+        return None;
+    }
+    let (sa, sb) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(p, q), (x, y)| (p + x, q + y));
+    let (ma, mb) = (sa / n, sb / n);
+    let (sab, saa, sbb) = pairs.iter().fold((0.0, 0.0, 0.0), |(s, u, v), (x, y)| {
+        let (dx, dy) = (x - ma, y - mb);
+        (s + dx * dy, u + dx * dx, v + dy * dy)
+    });
+    (saa > 0.0 && sbb > 0.0).then(|| sab / (saa * sbb).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gray<T>(w: usize, v: Vec<T>) -> Gray<T> {
+        let h = v.len() / w;
+        Gray::from_vec(w, h, v).unwrap()
+    }
+
+    #[test]
+    fn material_accuracy_counts_only_metal_and_dielectric_pixels() {
+        let truth = gray(6, vec![0u8, 1, 1, 2, 2, 3]);
+        let pred = gray(6, vec![1u8, 1, 2, 2, 0, 3]);
+        let m = material_metrics(&pred, &truth).unwrap();
+        // Foreground pairs: (1,1) right, (1,2) wrong, (2,2) right; (2,0) is not counted.
+        assert_eq!(m.foreground_pixels, 3);
+        assert!((m.metal_vs_dielectric_accuracy.unwrap() - 2.0 / 3.0).abs() < 1e-12);
+        assert_eq!(m.confusion[2][0], 1);
+        assert_eq!(m.class_iou[3], Some(1.0));
+        assert!(material_metrics(&gray(3, vec![0u8, 1, 4]), &gray(3, vec![0u8; 3])).is_err());
+    }
+
+    #[test]
+    fn mask_precision_recall_and_distractors() {
+        let truth = gray(5, vec![255u8, 255, 0, 0, 0]);
+        let pred = gray(5, vec![255u8, 0, 255, 255, 0]);
+        let shiny = gray(5, vec![0u8, 0, 1, 0, 1]);
+        let m = mask_metrics(&pred, &truth, Some(&shiny)).unwrap();
+        assert_eq!((m.precision, m.recall), (Some(1.0 / 3.0), Some(0.5)));
+        assert_eq!(m.iou, Some(0.25));
+        assert_eq!(m.false_positive_on_distractors, Some(0.5));
+        let empty = gray(5, vec![0u8; 5]);
+        let m = mask_metrics(&empty, &empty, None).unwrap();
+        assert_eq!((m.iou, m.precision, m.recall), (None, None, None));
+    }
+
+    #[test]
+    fn pearson_of_affine_series_is_one_and_of_constant_is_none() {
+        let a = [1.0f32, 2.0, 4.0, f32::NAN, 8.0];
+        let b = [3.0f32, 5.0, 9.0, 1.0, 17.0];
+        assert!((pearson(&a, &b).unwrap() - 1.0).abs() < 1e-12);
+        let neg: Vec<f32> = b.iter().map(|v| -v).collect();
+        assert!((pearson(&a, &neg).unwrap() + 1.0).abs() < 1e-12);
+        assert_eq!(pearson(&a, &[2.0; 5]), None);
+    }
+
+    #[test]
+    fn normals_are_scored_on_objects_and_by_type() {
+        let n = |v: [f32; 3]| v;
+        let truth = Image::<f32, 3>::from_vec(3, 1, [n([0., 0., 1.]); 3].concat()).unwrap();
+        let est = Image::<f32, 3>::from_vec(
+            3,
+            1,
+            [n([0., 0., 1.]), n([1., 0., 0.]), n([0., 1., 0.])].concat(),
+        )
+        .unwrap();
+        let objects = gray(3, vec![1u8, 1, 0]);
+        let types = gray(3, vec![1u8, 2, 2]);
+        let m = normal_metrics(
+            &est,
+            &truth,
+            &objects,
+            Some((&types, &["none", "a", "b"])),
+            None,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!(m.count, 2);
+        assert!((m.mean_deg - 45.0).abs() < 1e-9);
+        assert_eq!(m.mean_deg_by_type.get("a"), Some(&0.0));
+        assert!((m.mean_deg_by_type["b"] - 90.0).abs() < 1e-9);
+        assert!(!m.mean_deg_by_type.contains_key("none"));
+    }
+}

@@ -1,0 +1,346 @@
+//! `polar-vision eval`: every sample of a dataset through `run`, in parallel, resumable and
+//! shardable; per-sample records, aggregates per family and task, and a summary table.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use polar_eval::{Aggregate, SCHEMA_VERSION, Summary, aggregate};
+use polar_io::Shard;
+use polar_io::files;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::CliError;
+use crate::run::{RunArgs, SampleReport, run_sample};
+use crate::stokes::prepare_out;
+
+/// Per-sample record kept under `OUT/samples/<name>/`, what makes a run resumable.
+const RECORD: &str = "eval.json";
+
+/// Arguments of `polar-vision eval`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Writes OUT/samples/<name>/ (the outputs of `run` for each sample and \
+eval.json, its record), OUT/metrics.json (schema_version, per sample keyed by folder name, \
+aggregates per family and task) and OUT/summary.md (a table). A sample that fails is recorded \
+and the others go on. Rerunning the same command resumes: samples with a record made with the \
+same options are not run again. With --shard K/N only the samples whose index i (sorted by \
+name) has i mod N = K-1 are run; `polar-vision eval-merge` joins the shards' outputs."
+)]
+pub struct EvalArgs {
+    /// A dataset folder: its sub-folders holding raw.png or stokes.exr are the samples
+    /// (a polar-datagen output, or any folder of sample directories).
+    pub dataset: PathBuf,
+    /// How each sample is run (the options of `polar-vision run`).
+    #[command(flatten)]
+    pub run: EvalRunArgs,
+    /// Samples evaluated at once (default: all cores).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub jobs: Option<u16>,
+    /// Evaluate only shard K of N (1-based).
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<Shard>,
+}
+
+/// `run`'s options as `eval` takes them (the sample comes from the dataset).
+#[derive(Debug, Args)]
+pub struct EvalRunArgs {
+    /// Output directory (created if missing; must be new or hold this same evaluation).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Tasks, comma-separated (default: all).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = crate::tasks::Task::ALL)]
+    pub tasks: Vec<crate::tasks::Task>,
+    /// Which file of each sample to read (default: raw.png where there is one).
+    #[arg(long, value_enum)]
+    pub input: Option<crate::input::Source>,
+    /// How to read the input.
+    #[command(flatten)]
+    pub read: crate::input::InputArgs,
+    /// Options of the tasks.
+    #[command(flatten)]
+    pub task: crate::task_options::TaskArgs,
+}
+
+impl EvalRunArgs {
+    fn as_run(&self, sample: &Path, out: &Path) -> RunArgs {
+        RunArgs {
+            sample: sample.to_owned(),
+            out: out.to_owned(),
+            tasks: self.tasks.clone(),
+            input: self.input,
+            threads: None,
+            read: self.read.clone(),
+            task: self.task.clone(),
+        }
+    }
+
+    /// What must be equal for a stored record to be reused.
+    fn fingerprint(&self) -> String {
+        format!(
+            "{:?}|{:?}|{:?}|{:?}",
+            self.tasks, self.input, self.read, self.task
+        )
+    }
+}
+
+/// One sample's record.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Record {
+    /// The options it was made with ([`EvalRunArgs`]).
+    pub options: String,
+    /// The run's report, or why the sample could not be read.
+    pub result: Result<SampleReport, String>,
+}
+
+/// `OUT/metrics.json` of `eval`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct EvalReport {
+    /// Layout version.
+    pub schema_version: u32,
+    /// Per sample (folder name): the report or the error.
+    pub samples: BTreeMap<String, Result<SampleReport, String>>,
+    /// Per family, per task: means of every metric, counts and time per megapixel.
+    pub families: BTreeMap<String, BTreeMap<String, Aggregate>>,
+}
+
+/// Runs the subcommand; `Ok(false)` when a sample or a task failed.
+pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
+    let samples = list_samples(&args.dataset)?;
+    let shard = args.shard.unwrap_or(Shard::ALL);
+    let mine: Vec<&PathBuf> = samples
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| shard.owns(*i))
+        .map(|(_, s)| s)
+        .collect();
+    let out = &args.run.out;
+    prepare_out(out)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.map_or(0, usize::from))
+        .build()
+        .map_err(|e| CliError::Threads(e.to_string()))?;
+    let bar = progress(mine.len());
+    let fingerprint = args.run.fingerprint();
+    let records: Vec<(String, Record)> = pool.install(|| {
+        mine.par_iter()
+            .map(|s| {
+                let r = evaluate_one(s, out, &args.run, &fingerprint);
+                bar.inc(1);
+                r
+            })
+            .collect::<Result<_, _>>()
+    })?;
+    bar.finish_and_clear();
+    let report = write_report(
+        out,
+        records.into_iter().map(|(n, r)| (n, r.result)).collect(),
+    )?;
+    print_failures(&report);
+    Ok(report
+        .samples
+        .values()
+        .all(|r| r.as_ref().is_ok_and(SampleReport::all_ok)))
+}
+
+/// Arguments of `polar-vision eval-merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The `--out` folders of the shards (or one folder all shards wrote into).
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Where the joined metrics.json and summary.md go.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+/// Joins the per-sample records of shard folders into one report.
+pub fn merge(args: &MergeArgs) -> Result<bool, CliError> {
+    let mut samples = BTreeMap::new();
+    let mut options: Option<String> = None;
+    for dir in &args.shards {
+        for (name, record) in read_records(dir)? {
+            if options.get_or_insert_with(|| record.options.clone()) != &record.options {
+                return Err(CliError::MergeOptions(dir.join("samples").join(&name)));
+            }
+            samples.insert(name, record.result);
+        }
+    }
+    if samples.is_empty() {
+        return Err(CliError::NoSamples(args.shards[0].clone()));
+    }
+    prepare_out(&args.out)?;
+    let report = write_report(&args.out, samples)?;
+    print_failures(&report);
+    Ok(report.samples.values().all(Result::is_ok))
+}
+
+/// The sample directories under `dataset`, sorted by name (hidden folders skipped).
+pub fn list_samples(dataset: &Path) -> Result<Vec<PathBuf>, CliError> {
+    let entries = std::fs::read_dir(dataset).map_err(|e| CliError::read(dataset, e))?;
+    let mut out = Vec::new();
+    for e in entries {
+        let path = e.map_err(|e| CliError::read(dataset, e))?.path();
+        let hidden = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_none_or(|n| n.starts_with('.'));
+        let is_sample = path.join(files::RAW).is_file() || path.join(files::STOKES).is_file();
+        if path.is_dir() && !hidden && is_sample {
+            out.push(path);
+        }
+    }
+    out.sort();
+    if out.is_empty() {
+        return Err(CliError::NoSamples(dataset.to_owned()));
+    }
+    Ok(out)
+}
+
+fn sample_name(sample: &Path) -> String {
+    sample
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Runs one sample unless its record with the same options exists; records the result.
+fn evaluate_one(
+    sample: &Path,
+    out: &Path,
+    run: &EvalRunArgs,
+    fingerprint: &str,
+) -> Result<(String, Record), CliError> {
+    let name = sample_name(sample);
+    let dir = out.join("samples").join(&name);
+    let path = dir.join(RECORD);
+    if let Ok(old) = polar_io::read_json::<Record>(&path)
+        && old.options == fingerprint
+    {
+        return Ok((name, old));
+    }
+    let result = run_sample(sample, &dir, &run.as_run(sample, &dir)).map_err(|e| e.to_string());
+    let record = Record {
+        options: fingerprint.to_owned(),
+        result,
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| CliError::write(&dir, e))?;
+    polar_io::write_json(&path, &record)?;
+    Ok((name, record))
+}
+
+fn read_records(dir: &Path) -> Result<Vec<(String, Record)>, CliError> {
+    let root = dir.join("samples");
+    let entries = std::fs::read_dir(&root).map_err(|e| CliError::read(&root, e))?;
+    let mut out = Vec::new();
+    for e in entries {
+        let path = e.map_err(|e| CliError::read(&root, e))?.path().join(RECORD);
+        if path.is_file() {
+            let name = sample_name(path.parent().expect("a record lies in a sample folder"));
+            out.push((name, polar_io::read_json(&path)?));
+        }
+    }
+    Ok(out)
+}
+
+fn write_report(
+    out: &Path,
+    samples: BTreeMap<String, Result<SampleReport, String>>,
+) -> Result<EvalReport, CliError> {
+    let ok: BTreeMap<String, BTreeMap<String, Summary>> = samples
+        .iter()
+        .filter_map(|(n, r)| r.as_ref().ok().map(|r| (n.clone(), r.tasks.clone())))
+        .collect();
+    let report = EvalReport {
+        schema_version: SCHEMA_VERSION,
+        families: aggregate(&ok),
+        samples,
+    };
+    polar_io::write_json(out.join(files::vision::METRICS), &report)?;
+    let summary = summary_markdown(&report);
+    std::fs::write(out.join("summary.md"), summary)
+        .map_err(|e| CliError::write(out.join("summary.md"), e))?;
+    Ok(report)
+}
+
+/// The headline figures of each task, in the order a reader looks for them.
+const HEADLINES: [(&str, &str, &str); 9] = [
+    ("sfp", "normal.mean_deg", "mean angular error (deg)"),
+    ("sfp", "normal.median_deg", "median angular error (deg)"),
+    ("sfp", "normal.depth.relative_rmse", "depth RMSE / range"),
+    (
+        "material",
+        "metal_vs_dielectric_accuracy",
+        "metal vs dielectric accuracy",
+    ),
+    ("transparent", "iou", "mask IoU"),
+    (
+        "transparent",
+        "false_positive_on_distractors",
+        "false positives on opaque objects",
+    ),
+    ("dehaze", "dehazed.psnr_db", "dehazed PSNR (dB)"),
+    ("dehaze", "hazy.psnr_db", "hazy input PSNR (dB)"),
+    (
+        "dehaze",
+        "transmission_correlation",
+        "transmission correlation",
+    ),
+];
+
+/// `summary.md`: per family and task, the sample counts, time per megapixel and headlines.
+pub fn summary_markdown(report: &EvalReport) -> String {
+    let failed = report.samples.values().filter(|r| r.is_err()).count();
+    let mut s = format!(
+        "# Evaluation summary\n\n{} samples, {failed} unreadable.\n\n\
+| family | task | ok | failed | s / MP | figure | mean |\n|---|---|---|---|---|---|---|\n",
+        report.samples.len()
+    );
+    for (family, tasks) in &report.families {
+        for (task, agg) in tasks {
+            let time = agg.seconds_per_mp.map_or("-".into(), |t| format!("{t:.3}"));
+            let figures: Vec<(&str, f64)> = HEADLINES
+                .iter()
+                .filter(|(t, _, _)| t == task)
+                .filter_map(|(_, key, label)| agg.means.get(*key).map(|v| (*label, *v)))
+                .collect();
+            let head = format!(
+                "| {family} | {task} | {} | {} | {time} |",
+                agg.samples, agg.failed
+            );
+            if figures.is_empty() {
+                let _ = writeln!(s, "{head} - | - |");
+            }
+            for (label, v) in figures {
+                let _ = writeln!(s, "{head} {label} | {v:.4} |");
+            }
+        }
+    }
+    s
+}
+
+fn progress(n: usize) -> ProgressBar {
+    let bar = ProgressBar::new(n as u64);
+    if let Ok(style) =
+        ProgressStyle::with_template("{bar:40} {pos}/{len} samples, {elapsed} ({eta} left)")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+fn print_failures(report: &EvalReport) {
+    for (name, r) in &report.samples {
+        match r {
+            Err(e) => eprintln!("{name}: {e}"),
+            Ok(rep) => {
+                for (task, s) in rep.tasks.iter().filter(|(_, s)| !s.ok) {
+                    eprintln!("{name}: {task}: {}", s.messages.join("; "));
+                }
+            }
+        }
+    }
+}

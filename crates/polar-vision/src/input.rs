@@ -1,0 +1,283 @@
+//! Reading one observation: a raw mosaic PNG, or a sample directory (its `raw.png` by
+//! default, else its `stokes.exr`), into a [`polar_sensor::Observation`] through `polar-io`.
+//!
+//! Nothing here reads our dataset generator's private `meta.json` keys but one optional,
+//! documented one (`camera.fov_deg`, the horizontal field of view, docs/conventions.md),
+//! and `--fov` overrides it; without either the camera is taken as orthographic.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use polar_image::Gray;
+use polar_io::files;
+use polar_io::{GrayPng, LINEAR_STOKES_CHANNELS};
+use polar_optics::pixel_frame::CameraModel;
+use polar_sensor::mask::{count_saturated, validity_mask};
+use polar_sensor::{DemosaicMethod, Observation, StokesPlanes, stokes_planes};
+use serde_json::{Map, Value};
+
+use crate::error::CliError;
+
+/// Options that say how to read the input (shared by `stokes`, `run` and `eval`).
+#[derive(Clone, Debug, Args)]
+pub struct InputArgs {
+    /// Demosaicing method (error table and speed: README "Demosaicing error"):
+    ///   residual    the default: edge-aware residual interpolation (Ahmed et al. 2017,
+    ///               Morimatsu et al. 2020); lowest error on edges and fine texture; 2-4x
+    ///               bilinear's demosaicing time (bilinear's fused SIMD path is faster still)
+    ///   bilinear    polanalyser's COLOR_PolarMono, bit-exact; the fastest full-resolution
+    ///               method: to match polanalyser/OpenCV, or when speed matters most
+    ///   newton      Newton polynomial (Li et al. 2019): for comparison; beats bilinear on
+    ///               fine texture, loses at polarization edges; the slowest
+    ///   superpixel  half resolution, no interpolation: quick looks
+    #[arg(verbatim_doc_comment)]
+    #[arg(long, value_name = "NAME", default_value = "residual", value_parser = parse_method)]
+    pub demosaic: DemosaicMethod,
+    /// Significant bits of the sensor data (8, 10, 12 or 16). Default: the PNG's
+    /// sample depth. Use 10 or 12 for such sensors stored in 16-bit PNGs, with --align.
+    #[arg(long, value_name = "BITS", value_parser = clap::builder::PossibleValuesParser::new(["8", "10", "12", "16"]))]
+    pub bit_depth: Option<String>,
+    /// Where fewer-bit data sit in a 16-bit PNG: `right` (values 0..2^bits-1) or `left`
+    /// (shifted up, low bits zero). Outputs are in DN of the --bit-depth data either way.
+    #[arg(long, value_enum, default_value_t = Align::Right)]
+    pub align: Align,
+}
+
+/// Alignment of fewer-bit data in wider PNG samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Align {
+    /// Most significant bits used; the low bits are zero.
+    Left,
+    /// Least significant bits used; values are at most `2^bits − 1`.
+    Right,
+}
+
+/// Which file of a sample directory to read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Source {
+    /// `raw.png`, the mosaic a camera gives (demosaiced here).
+    Raw,
+    /// `stokes.exr`, Stokes planes computed elsewhere.
+    Stokes,
+}
+
+fn parse_method(s: &str) -> Result<DemosaicMethod, String> {
+    s.parse()
+        .map_err(|e: polar_sensor::SensorError| e.to_string())
+}
+
+/// The file an input path resolves to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum InputFile {
+    /// A raw mosaic PNG.
+    Raw(PathBuf),
+    /// A Stokes EXR.
+    Stokes(PathBuf),
+}
+
+/// Resolves `path` (a PNG or a sample directory) before any work; `source` forces one file.
+pub fn resolve(path: &Path, source: Option<Source>) -> Result<InputFile, CliError> {
+    if !path.exists() {
+        return Err(polar_io::Error::NotFound {
+            path: path.to_owned(),
+        }
+        .into());
+    }
+    if !path.is_dir() {
+        return match source {
+            Some(Source::Stokes) => Ok(InputFile::Stokes(path.to_owned())),
+            _ => Ok(InputFile::Raw(path.to_owned())),
+        };
+    }
+    let (raw, stokes) = (path.join(files::RAW), path.join(files::STOKES));
+    match source {
+        Some(Source::Raw) if raw.is_file() => Ok(InputFile::Raw(raw)),
+        Some(Source::Stokes) if stokes.is_file() => Ok(InputFile::Stokes(stokes)),
+        Some(s) => Err(CliError::MissingSource {
+            dir: path.to_owned(),
+            file: if s == Source::Raw {
+                files::RAW
+            } else {
+                files::STOKES
+            },
+        }),
+        None if raw.is_file() => Ok(InputFile::Raw(raw)),
+        None if stokes.is_file() => Ok(InputFile::Stokes(stokes)),
+        None => Err(CliError::Input(path.to_owned())),
+    }
+}
+
+/// Reads `file` into an observation (camera orthographic; see [`camera_model`]).
+pub fn read_observation(file: &InputFile, args: &InputArgs) -> Result<Observation, CliError> {
+    match file {
+        InputFile::Raw(path) => {
+            let bits = args.bit_depth.as_deref().map(|b| {
+                b.parse::<u8>()
+                    .expect("clap restricts the values to 8, 10, 12, 16")
+            });
+            let png = polar_io::read_mosaic(path)?;
+            let (raw, bits) = significant_bits(path, png, bits, args.align)?;
+            let level = saturation_level(&raw, bits);
+            check_exposure(path, &raw, bits, level)?;
+            let planes = stokes_planes(&raw, args.demosaic)?;
+            let flags = validity_mask(&raw, level, args.demosaic, &planes.s0);
+            Ok(Observation::new(planes, CameraModel::Orthographic).with_flags(flags))
+        }
+        InputFile::Stokes(path) => {
+            let stokes = polar_io::read_exr(path, LINEAR_STOKES_CHANNELS)?;
+            let planes = StokesPlanes::from_linear_stokes(&stokes);
+            Ok(Observation::new(planes, CameraModel::Orthographic))
+        }
+    }
+}
+
+/// The camera: `--fov` if given, else `camera.fov_deg` of `meta` (a horizontal field of
+/// view in degrees, as docs/conventions.md documents it), else orthographic.
+pub fn camera_model(fov: Option<f64>, meta: Option<&Map<String, Value>>) -> CameraModel {
+    let from_meta = || {
+        let cam = meta?.get("camera")?;
+        let horizontal = cam
+            .get("fov_axis")
+            .and_then(Value::as_str)
+            .is_none_or(|a| a == "x");
+        cam.get("fov_deg")
+            .and_then(Value::as_f64)
+            .filter(|_| horizontal)
+    };
+    match fov.or_else(from_meta) {
+        Some(f) if f > 0.0 && f < 180.0 => CameraModel::Pinhole { fov_x_deg: f },
+        _ => CameraModel::Orthographic,
+    }
+}
+
+/// The saturation level in DN of right-aligned `bits`-bit data: `2^bits − 1`, or a lower
+/// level the frame itself shows. A 16-bit PNG may hold 10- or 12-bit data (a camera's
+/// ADC): where the frame's maximum is `2^b − 1` for a smaller `b >= 8` and at least two
+/// pixels hold it, those pixels are clipped at the ADC's top and are flagged.
+pub fn saturation_level(raw: &Gray<u16>, bits: u8) -> u32 {
+    let full = (1u32 << bits) - 1;
+    let max = raw.as_slice().iter().copied().max().map_or(0, u32::from);
+    let at_max = raw
+        .as_slice()
+        .iter()
+        .filter(|&&v| u32::from(v) == max)
+        .count();
+    let adc_top = (8..bits).any(|b| max == (1u32 << b) - 1);
+    if adc_top && at_max >= 2 { max } else { full }
+}
+
+/// Applies `--bit-depth`/`--align`: returns the samples as right-aligned DN and their bit count.
+fn significant_bits(
+    path: &Path,
+    png: GrayPng,
+    bits: Option<u8>,
+    align: Align,
+) -> Result<(Gray<u16>, u8), CliError> {
+    let container = png.bit_depth.bits();
+    let bits = bits.unwrap_or(container);
+    if bits > container {
+        return Err(CliError::BitDepthTooLarge {
+            path: path.to_owned(),
+            bits,
+            container,
+        });
+    }
+    let mut raw = png.image;
+    if bits == container {
+        return Ok((raw, bits));
+    }
+    let shift = container - bits;
+    let (bad, hint): (Box<dyn Fn(u16) -> bool>, _) = match align {
+        Align::Left => (
+            Box::new(move |v| v & ((1 << shift) - 1) != 0),
+            " (low bits are set; try --align right)",
+        ),
+        Align::Right => (
+            Box::new(move |v| v >> bits != 0),
+            " (value too large; try --align left)",
+        ),
+    };
+    let w = raw.width();
+    if let Some(k) = raw.as_slice().iter().position(|&v| bad(v)) {
+        let align = if align == Align::Left {
+            "left"
+        } else {
+            "right"
+        };
+        let value = raw.as_slice()[k];
+        return Err(CliError::Alignment {
+            path: path.to_owned(),
+            x: k % w,
+            y: k / w,
+            value,
+            bits,
+            container,
+            align,
+            hint,
+        });
+    }
+    if align == Align::Left {
+        raw.as_mut_slice().iter_mut().for_each(|v| *v >>= shift);
+    }
+    Ok((raw, bits))
+}
+
+/// Rejects frames without usable light; warns about partly saturated ones.
+fn check_exposure(path: &Path, raw: &Gray<u16>, bits: u8, level: u32) -> Result<(), CliError> {
+    if raw.as_slice().iter().all(|&v| v == 0) {
+        return Err(CliError::AllZero(path.to_owned()));
+    }
+    let saturated = count_saturated(raw, level);
+    let n = raw.as_slice().len();
+    if saturated == n {
+        return Err(CliError::AllSaturated {
+            path: path.to_owned(),
+            level,
+            bits,
+        });
+    }
+    if saturated > 0 {
+        eprintln!(
+            "warning: {}: {saturated} of {n} pixels ({:.3}%) are saturated at {level} DN; flagged in the mask",
+            path.display(),
+            100.0 * saturated as f64 / n as f64
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn saturation_at_a_smaller_adc_top_is_found_only_when_repeated() {
+        let img = |v: Vec<u16>| Gray::from_vec(v.len(), 1, v).unwrap();
+        assert_eq!(saturation_level(&img(vec![4095, 4095, 10]), 16), 4095);
+        assert_eq!(saturation_level(&img(vec![4095, 4000, 10]), 16), 65535);
+        assert_eq!(saturation_level(&img(vec![4094, 4094, 10]), 16), 65535);
+        assert_eq!(saturation_level(&img(vec![255, 255]), 8), 255);
+    }
+
+    #[test]
+    fn camera_from_flag_then_meta_then_orthographic() {
+        let meta = json!({"camera": {"fov_deg": 35.0, "fov_axis": "x"}});
+        let meta = meta.as_object().unwrap();
+        assert_eq!(
+            camera_model(Some(50.0), Some(meta)),
+            CameraModel::Pinhole { fov_x_deg: 50.0 }
+        );
+        assert_eq!(
+            camera_model(None, Some(meta)),
+            CameraModel::Pinhole { fov_x_deg: 35.0 }
+        );
+        let vertical = json!({"camera": {"fov_deg": 35.0, "fov_axis": "y"}});
+        assert_eq!(
+            camera_model(None, vertical.as_object()),
+            CameraModel::Orthographic
+        );
+        assert_eq!(camera_model(None, None), CameraModel::Orthographic);
+        assert_eq!(camera_model(Some(200.0), None), CameraModel::Orthographic);
+    }
+}

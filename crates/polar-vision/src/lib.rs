@@ -1,0 +1,12 @@
+//! The polarization vision pipeline as a library: reading an observation ([`input`]), the
+//! Stokes front end ([`stokes`]), the analysis tasks ([`tasks`]) run on one sample
+//! ([`run`]) or a whole dataset ([`eval`]). The `polar-vision` binary is a thin shell over
+//! these modules, one per subcommand.
+
+pub mod error;
+pub mod eval;
+pub mod input;
+pub mod run;
+pub mod stokes;
+pub mod task_options;
+pub mod tasks;

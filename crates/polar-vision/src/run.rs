@@ -1,0 +1,191 @@
+//! `polar-vision run`: one sample directory (or raw PNG) through the requested tasks.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use polar_eval::{SCHEMA_VERSION, Summary};
+use polar_io::files::vision;
+use polar_io::{GroundTruth, Validation};
+use serde::{Deserialize, Serialize};
+
+use crate::error::CliError;
+use crate::input::{InputArgs, InputFile, Source, camera_model, read_observation, resolve};
+use crate::stokes::{prepare_out, write_outputs};
+use crate::task_options::TaskArgs;
+use crate::tasks::{Context, Failure, Task};
+
+/// Arguments of `polar-vision run`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Writes to --out the Stokes outputs of `stokes` (stokes.exr, dolp.exr, \
+aolp.exr, aolp.png, ...), each task's outputs (sfp: normal.exr, depth.exr, normal_confidence.exr, \
+reflection.png; transparent: transparent.png, transparent_score.exr; material: material.png, \
+material_confidence.exr; dehaze: dehazed.exr, transmission.exr, haze_depth.exr), pictures under \
+pictures/, and, where the sample has gt/, metrics.json with each task's figures and time. \
+A task that cannot run on the input says why; the others still run. Exit code 0 only if every \
+requested task succeeded."
+)]
+pub struct RunArgs {
+    /// A sample directory (raw.png and/or stokes.exr, optional meta.json and gt/), or a raw
+    /// mosaic PNG.
+    pub sample: PathBuf,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Tasks to run, comma-separated (default: all). They run in the order sfp,
+    /// transparent, material, dehaze; material uses the normals and mask of the first two.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = Task::ALL)]
+    pub tasks: Vec<Task>,
+    /// Which file of a sample directory to read: raw (the camera's mosaic; the default
+    /// where there is one) or stokes (stokes.exr).
+    #[arg(long, value_enum)]
+    pub input: Option<Source>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub threads: Option<u16>,
+    /// How to read the input.
+    #[command(flatten)]
+    pub read: InputArgs,
+    /// Options of the tasks.
+    #[command(flatten)]
+    pub task: TaskArgs,
+}
+
+/// What `run` found for one sample: `metrics.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SampleReport {
+    /// Layout version of this file ([`polar_eval::SCHEMA_VERSION`]).
+    pub schema_version: u32,
+    /// The input file read.
+    pub input: String,
+    /// Image width and height.
+    pub size: [usize; 2],
+    /// Seconds to read and demosaic.
+    pub read_seconds: f64,
+    /// Per task: status, messages, time and metrics.
+    pub tasks: BTreeMap<String, Summary>,
+}
+
+impl SampleReport {
+    /// `true` when every task succeeded.
+    pub fn all_ok(&self) -> bool {
+        self.tasks.values().all(|s| s.ok)
+    }
+}
+
+/// Runs the subcommand; `Ok(false)` when a task could not run.
+pub fn run(args: &RunArgs) -> Result<bool, CliError> {
+    if let Some(n) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(usize::from(n))
+            .build_global()
+            .map_err(|e| CliError::Threads(e.to_string()))?;
+    }
+    let report = run_sample(&args.sample, &args.out, args)?;
+    for (task, s) in &report.tasks {
+        let status = if s.ok { "ok" } else { "FAILED" };
+        eprintln!("{task}: {status} in {:.3} s", s.seconds);
+        for m in &s.messages {
+            eprintln!("  {m}");
+        }
+    }
+    Ok(report.all_ok())
+}
+
+/// Reads `sample`, runs the tasks of `args`, writes every output into `out`, and returns
+/// the report (also written as `metrics.json` where the sample has ground truth).
+pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleReport, CliError> {
+    let file = resolve(sample, args.input)?;
+    prepare_out(out)?;
+    let start = Instant::now();
+    let dir = sample.is_dir().then_some(sample);
+    let meta = dir.map(polar_io::read_optional_meta).transpose()?.flatten();
+    let mut obs = read_observation(&file, &args.read)?;
+    obs.camera = camera_model(args.task.fov, meta.as_ref());
+    let gt = match dir {
+        Some(d) => polar_io::read_ground_truth(d, Validation::Check)?,
+        None => GroundTruth::default(),
+    };
+    check_gt_size(sample, &gt, obs.size())?;
+    let read_seconds = start.elapsed().as_secs_f64();
+    let raw_mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
+    write_outputs(out, &obs.planes, raw_mask)?;
+    std::fs::create_dir_all(out.join(vision::PICTURES))
+        .map_err(|e| CliError::write(out.join(vision::PICTURES), e))?;
+    let mut ctx = Context {
+        obs: &obs,
+        gt: &gt,
+        out,
+        normals: None,
+        transparent: None,
+    };
+    let (w, h) = obs.size();
+    let megapixels = (w * h) as f64 / 1e6;
+    let mut tasks = BTreeMap::new();
+    for task in Task::ALL.into_iter().filter(|t| args.tasks.contains(t)) {
+        let t0 = Instant::now();
+        let result = crate::task_options::execute(task, &mut ctx, &args.task);
+        let seconds = t0.elapsed().as_secs_f64();
+        let summary = match result {
+            Ok(o) => Summary {
+                ok: true,
+                messages: o.messages,
+                seconds,
+                megapixels,
+                metrics: o.metrics,
+            },
+            Err(Failure::Cli(e)) => return Err(e),
+            Err(f @ Failure::CannotRun(_)) => Summary {
+                ok: false,
+                messages: vec![f.to_string()],
+                seconds,
+                megapixels,
+                metrics: None,
+            },
+        };
+        tasks.insert(task.name().to_owned(), summary);
+    }
+    let report = SampleReport {
+        schema_version: SCHEMA_VERSION,
+        input: file_name(&file),
+        size: [w, h],
+        read_seconds,
+        tasks,
+    };
+    if has_any(&gt) {
+        polar_io::write_json(out.join(vision::METRICS), &report)?;
+    }
+    Ok(report)
+}
+
+fn file_name(file: &InputFile) -> String {
+    match file {
+        InputFile::Raw(p) | InputFile::Stokes(p) => p.display().to_string(),
+    }
+}
+
+fn has_any(gt: &GroundTruth) -> bool {
+    *gt != GroundTruth::default()
+}
+
+/// Ground truth of another size than the input cannot be scored: a clear error.
+fn check_gt_size(sample: &Path, gt: &GroundTruth, size: (usize, usize)) -> Result<(), CliError> {
+    let sizes = [
+        gt.normal.as_ref().map(|i| i.size()),
+        gt.depth.as_ref().map(|i| i.size()),
+        gt.material.as_ref().map(|i| i.size()),
+        gt.transparent.as_ref().map(|i| i.size()),
+        gt.clear.as_ref().map(|i| i.size()),
+        gt.transmission.as_ref().map(|i| i.size()),
+    ];
+    match sizes.into_iter().flatten().find(|&s| s != size) {
+        Some(gt_size) => Err(CliError::GtSize {
+            sample: sample.to_owned(),
+            input: size,
+            gt: gt_size,
+        }),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,110 @@
+//! The analysis tasks as `run` and `eval` see them: a closed set, run in dependency order
+//! over one [`Context`], each writing its outputs and, with ground truth, its metrics.
+
+use std::fmt;
+use std::path::Path;
+
+use clap::ValueEnum;
+use polar_image::{Gray, Image};
+use polar_io::GroundTruth;
+use polar_sensor::Observation;
+use serde_json::Value;
+
+use crate::error::CliError;
+
+/// One analysis task.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, ValueEnum)]
+pub enum Task {
+    /// Shape from polarization: normal.exr, depth.exr (polar-shape).
+    Sfp,
+    /// Transparent-object detection: transparent.png (polar-transparency).
+    Transparent,
+    /// Material classification: material.png (polar-material; uses sfp's normals and the
+    /// transparency mask when those tasks ran).
+    Material,
+    /// Polarization dehazing: dehazed.exr, transmission.exr (polar-dehaze).
+    Dehaze,
+}
+
+impl Task {
+    /// Every task, in the order they run (a task's inputs come before it).
+    pub const ALL: [Task; 4] = [Task::Sfp, Task::Transparent, Task::Material, Task::Dehaze];
+
+    /// The name used on the command line and in `metrics.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Task::Sfp => "sfp",
+            Task::Transparent => "transparent",
+            Task::Material => "material",
+            Task::Dehaze => "dehaze",
+        }
+    }
+}
+
+impl fmt::Display for Task {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What the tasks read, and what earlier tasks left for later ones.
+pub struct Context<'a> {
+    /// The observation.
+    pub obs: &'a Observation,
+    /// Ground truth, where the sample has any.
+    pub gt: &'a GroundTruth,
+    /// Where outputs go.
+    pub out: &'a Path,
+    /// Normals from `sfp`, for `material`.
+    pub normals: Option<Image<f32, 3>>,
+    /// Transparency mask from `transparent`, for `material`.
+    pub transparent: Option<Gray<u8>>,
+}
+
+/// What one task reports: metrics (with ground truth) and messages for the user.
+#[derive(Debug, Default)]
+pub struct Outcome {
+    /// Task metrics, `None` without the ground truth they need.
+    pub metrics: Option<Value>,
+    /// Warnings and fallbacks taken.
+    pub messages: Vec<String>,
+}
+
+/// Why a task did not produce its outputs.
+#[derive(Debug)]
+pub enum Failure {
+    /// The input does not allow the task (said why); not an error of the program.
+    CannotRun(String),
+    /// Reading or writing failed.
+    Cli(CliError),
+}
+
+impl From<CliError> for Failure {
+    fn from(e: CliError) -> Self {
+        Failure::Cli(e)
+    }
+}
+
+impl fmt::Display for Failure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Failure::CannotRun(why) => write!(f, "cannot run: {why}"),
+            Failure::Cli(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// The object pixels of the conventions (`gt/material.png` label != 0), if known.
+pub fn object_mask(gt: &GroundTruth) -> Option<Gray<u8>> {
+    let m = gt.material.as_ref()?;
+    let mut out = m.clone();
+    out.as_mut_slice()
+        .iter_mut()
+        .for_each(|v| *v = u8::from(*v != 0));
+    Some(out)
+}
+
+/// Serializes task metrics for `metrics.json`.
+pub fn to_json(value: &impl serde::Serialize) -> Result<Value, CliError> {
+    serde_json::to_value(value).map_err(|e| CliError::Json(e.to_string()))
+}
