@@ -26,6 +26,9 @@ py=tools/.venv/bin/python
 step "image primitives vs opencv-contrib / scikit-image"
 "$py" tools/imgproc_goldens.py --check
 
+step "task metrics vs numpy / scikit-image"
+"$py" tools/eval_goldens.py --check
+
 step "front end vs polanalyser"
 "$py" tools/polanalyser_goldens.py --check
 

@@ -105,6 +105,9 @@ pub enum CliError {
         /// The system's reason.
         reason: String,
     },
+    /// The command line does not parse (or asks for help).
+    #[error("{0}")]
+    Usage(String),
     /// The worker thread pool could not be made.
     #[error("cannot start worker threads: {0}")]
     Threads(String),

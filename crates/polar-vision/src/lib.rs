@@ -3,6 +3,7 @@
 //! ([`run`]) or a whole dataset ([`eval`]). The `polar-vision` binary is a thin shell over
 //! these modules, one per subcommand.
 
+pub mod cli;
 pub mod error;
 pub mod eval;
 pub mod input;
