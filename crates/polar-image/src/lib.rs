@@ -2,6 +2,9 @@
 //! 4-channel Stokes image and a 1-channel DoLP image cannot be mixed up.
 //! Pixels are stored row-major and interleaved; row 0 is the top row.
 
+mod border;
+
+pub use border::Border;
 use thiserror::Error;
 
 /// Errors from constructing or combining images.
@@ -163,6 +166,13 @@ impl<T: Copy, const C: usize> Image<T, C> {
             data,
         })
     }
+}
+
+/// Whether a `width × height` division-of-focal-plane mosaic is made of whole 2×2
+/// super-pixels (at least one): the one size rule every mosaic reader and demosaicer checks.
+pub fn is_mosaic_size(width: usize, height: usize) -> bool {
+    let ok = |n: usize| n >= 2 && n.is_multiple_of(2);
+    ok(width) && ok(height)
 }
 
 #[cfg(test)]

@@ -21,7 +21,6 @@
 //! | [`psnr`], [`ssim`], [`ssim_map`] | `skimage.metrics.peak_signal_noise_ratio`, `structural_similarity` | SSIM: `BORDER_REFLECT` (scipy `reflect`) |
 //! | [`angular_error`], [`iou`], [`ConfusionMatrix`] | numpy formulas in the golden script | - |
 
-mod border;
 mod filter;
 mod guided;
 mod label;
@@ -30,7 +29,7 @@ mod metrics;
 mod morph;
 mod threshold;
 
-pub use border::Border;
+pub use polar_image::Border;
 pub use filter::{
     box_filter, gaussian_blur, gaussian_kernel, scharr, sep_filter, sobel, sobel_kernels,
 };

@@ -107,8 +107,7 @@ pub fn read_mosaic(path: impl AsRef<Path>) -> Result<GrayPng> {
 
 /// Checks that a `width x height` mosaic holds whole 2x2 super-pixels.
 pub fn check_mosaic_size(path: &Path, width: usize, height: usize) -> Result<()> {
-    let ok = |n: usize| n >= 2 && n.is_multiple_of(2);
-    if ok(width) && ok(height) {
+    if polar_image::is_mosaic_size(width, height) {
         Ok(())
     } else {
         Err(Error::MosaicSize {

@@ -101,11 +101,11 @@ pub enum SensorError {
 
 /// Checks that a mosaic of `width x height` is made of whole 2x2 super-pixels.
 pub fn check_mosaic_size(width: usize, height: usize) -> Result<(), SensorError> {
-    if width < 2 || height < 2 {
-        return Err(SensorError::TooSmall { width, height });
+    if polar_image::is_mosaic_size(width, height) {
+        Ok(())
+    } else if width < 2 || height < 2 {
+        Err(SensorError::TooSmall { width, height })
+    } else {
+        Err(SensorError::OddSize { width, height })
     }
-    if !width.is_multiple_of(2) || !height.is_multiple_of(2) {
-        return Err(SensorError::OddSize { width, height });
-    }
-    Ok(())
 }

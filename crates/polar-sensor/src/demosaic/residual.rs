@@ -27,7 +27,7 @@
 //! Measured (example `demosaic_error`): better than `bilinear` in every column
 //! (PSNR of each channel, DoLP and AoLP error) on edges, on fine texture and on both.
 
-use polar_image::PolarizerStack;
+use polar_image::{Border, PolarizerStack};
 use rayon::prelude::*;
 
 use crate::layout::{Mosaic, MosaicSample, channel_at};
@@ -40,9 +40,7 @@ const WEIGHT_FLOOR: f32 = 1.0;
 
 /// Reflect-101 index (`-1 → 1`, `n → n − 2`) for any offset; `n >= 2`.
 fn mirror(i: isize, n: usize) -> usize {
-    let period = 2 * (n as isize - 1);
-    let m = i.rem_euclid(period);
-    (if m >= n as isize { period - m } else { m }) as usize
+    Border::Reflect101.index(i, n)
 }
 
 /// A plane mirrored by [`PAD`] on every side, indexed by image coordinates plus offsets.

@@ -1,4 +1,5 @@
-//! Border extrapolation, named after OpenCV's `cv::BorderTypes`.
+//! Border extrapolation, named after OpenCV's `cv::BorderTypes`: one definition for the
+//! image primitives (`polar-imgproc`) and the demosaicers (`polar-sensor`).
 
 /// How pixels outside the image are made up (OpenCV names; `|` marks the image edge,
 /// for a row `abcdefgh`).
@@ -45,7 +46,7 @@ impl Border {
 
     /// Copies `row` into `out` (length `row.len() + left + right`) with `left`/`right`
     /// extrapolated pixels on each side.
-    pub(crate) fn pad_row<T: Copy>(self, row: &[T], left: usize, out: &mut [T]) {
+    pub fn pad_row<T: Copy>(self, row: &[T], left: usize, out: &mut [T]) {
         let n = row.len();
         out[left..left + n].copy_from_slice(row);
         for (k, o) in out[..left].iter_mut().enumerate() {
