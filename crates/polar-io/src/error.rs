@@ -31,6 +31,18 @@ pub enum Error {
         /// What the decoder reported.
         detail: String,
     },
+    /// The header claims more pixels than [`crate::MAX_PIXELS`]; refused before decoding.
+    #[error("{path}: {width}x{height} is more than the {max} pixels this reader accepts")]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Width in the header.
+        width: usize,
+        /// Height in the header.
+        height: usize,
+        /// The limit.
+        max: usize,
+    },
     /// The image has a colour type this reader does not accept (e.g. an RGB PNG as a mosaic).
     #[error("{path}: colour type {found}, expected {expected}")]
     ColorType {

@@ -29,6 +29,24 @@ pub use sample::{
 pub use shard::{Shard, ShardError};
 pub use validate::{Rule, Validation, check_channels, check_stokes, check_u8};
 
+/// The most pixels an image may have to be read: 100 megapixels, 40 times a 5-MP sensor.
+/// Checked from the file's header before any pixel buffer is allocated, so a small file
+/// that claims a huge image is refused at once instead of exhausting memory.
+pub const MAX_PIXELS: usize = 100_000_000;
+
+/// Refuses a `width × height` image of more than [`MAX_PIXELS`].
+pub(crate) fn check_pixels(path: &std::path::Path, width: usize, height: usize) -> Result<()> {
+    match width.checked_mul(height) {
+        Some(n) if n <= MAX_PIXELS => Ok(()),
+        _ => Err(Error::TooLarge {
+            path: path.to_owned(),
+            width,
+            height,
+            max: MAX_PIXELS,
+        }),
+    }
+}
+
 /// Channel names of a full Stokes EXR (`stokes.exr`).
 pub const STOKES_CHANNELS: [&str; 4] = ["S0", "S1", "S2", "S3"];
 /// Channel names of a linear Stokes EXR (the vision output when S3 is unknown).

@@ -146,6 +146,10 @@ pub fn exr_channel_names(path: impl AsRef<Path>) -> Result<Vec<String>> {
 type AnyLayer = Layer<AnyChannels<FlatSamples>>;
 
 fn read_single_layer(path: &Path) -> Result<AnyLayer> {
+    let meta = MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
+    for header in meta.headers.iter() {
+        crate::check_pixels(path, header.layer_size.0, header.layer_size.1)?;
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

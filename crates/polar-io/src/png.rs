@@ -219,6 +219,8 @@ fn decode(path: &Path) -> Result<Decoded> {
     let mut decoder = png::Decoder::new_with_limits(BufReader::new(file), limits);
     decoder.set_transformations(png::Transformations::IDENTITY);
     let mut reader = decoder.read_info().map_err(|e| decode_error(path, e))?;
+    let info = reader.info();
+    crate::check_pixels(path, info.width as usize, info.height as usize)?;
     let len = reader
         .output_buffer_size()
         .ok_or_else(|| Error::corrupt(path, "PNG", "image size overflows memory"))?;

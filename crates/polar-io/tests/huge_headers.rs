@@ -1,0 +1,95 @@
+//! Regressions of the hostile-input issue: tiny files whose headers claim huge images
+//! aborted the process on allocation. Both readers must refuse them from the header.
+
+use std::path::Path;
+
+use polar_image::Gray;
+use polar_io::{Error, MAX_PIXELS};
+
+/// CRC-32 (IEEE) as PNG chunks use it.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = 0xFFFF_FFFFu32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+    let mut body = kind.to_vec();
+    body.extend_from_slice(data);
+    let mut out = (data.len() as u32).to_be_bytes().to_vec();
+    out.extend_from_slice(&body);
+    out.extend_from_slice(&crc32(&body).to_be_bytes());
+    out
+}
+
+/// A PNG of a few dozen bytes whose header says `w x h`, 16-bit grey, with no pixel data.
+fn png_claiming(path: &Path, w: u32, h: u32) {
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[16, 0, 0, 0, 0]);
+    let mut file = b"\x89PNG\r\n\x1a\n".to_vec();
+    file.extend(chunk(b"IHDR", &ihdr));
+    // An empty zlib stream: the decoder reads the header up to the first IDAT.
+    file.extend(chunk(
+        b"IDAT",
+        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+    ));
+    file.extend(chunk(b"IEND", &[]));
+    std::fs::write(path, file).unwrap();
+}
+
+fn assert_too_large(result: Result<impl std::fmt::Debug, Error>) {
+    match result {
+        Err(Error::TooLarge { max, .. }) => assert_eq!(max, MAX_PIXELS),
+        other => panic!("expected TooLarge, got {other:?}"),
+    }
+}
+
+#[test]
+fn tiny_png_claiming_200000_squared_pixels_is_refused_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.png");
+    png_claiming(&path, 200_000, 200_000);
+    assert!(std::fs::metadata(&path).unwrap().len() < 100);
+    // Without the header check this aborted the process (a 40 GB allocation).
+    assert_too_large(polar_io::read_mosaic(&path));
+    assert_too_large(polar_io::read_gray8_png(&path));
+}
+
+#[test]
+fn tiny_exr_claiming_100000_squared_pixels_is_refused_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.exr");
+    let img = Gray::from_vec(2, 2, vec![1.0f32; 4]).unwrap();
+    polar_io::write_exr_with(&path, &img, ["Y"], polar_io::ExrCompression::None).unwrap();
+    // Patch the data window (box2i: xmin, ymin, xmax, ymax) to claim 100000 x 100000.
+    let mut bytes = std::fs::read(&path).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    bytes[at + 8..at + 12].copy_from_slice(&99_999i32.to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&99_999i32.to_le_bytes());
+    std::fs::write(&path, bytes).unwrap();
+    let result = polar_io::read_exr_channel(&path, "Y");
+    // The exr crate may reject the inconsistent file itself; it must never allocate 40 GB.
+    assert!(
+        matches!(result, Err(Error::TooLarge { .. } | Error::Corrupt { .. })),
+        "{result:?}"
+    );
+}
+
+#[test]
+fn images_at_the_limit_are_still_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ok.png");
+    polar_io::write_gray16_png(&path, &Gray::from_vec(4, 2, vec![7u16; 8]).unwrap()).unwrap();
+    assert_eq!(polar_io::read_mosaic(&path).unwrap().image.size(), (4, 2));
+}
