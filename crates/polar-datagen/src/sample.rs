@@ -36,9 +36,14 @@ impl SampleWorker for RenderWorker {
     }
 }
 
-/// Renders a scene, mapping errors to the sample id.
+/// Renders a scene (with a medium also its dehazed ground truth, see
+/// [`RenderOutput::dehazed`]), mapping errors to the sample id.
 pub fn render(scene: &Scene, id: &str) -> Result<RenderOutput, Error> {
-    polar_render::render(scene, &RenderOptions::default(), &|_, _| {}).map_err(|e| Error::Sample {
+    let opts = RenderOptions {
+        dehazed: true,
+        ..RenderOptions::default()
+    };
+    polar_render::render(scene, &opts, &|_, _| {}).map_err(|e| Error::Sample {
         id: id.to_owned(),
         message: e.to_string(),
     })
@@ -119,8 +124,8 @@ fn io_err(id: &str) -> impl Fn(polar_io::Error) -> Error + '_ {
 }
 
 /// Writes meta.json, raw.png, stokes.exr, polarizers.exr (the noiseless full-resolution
-/// images behind the four micro-polarizers) and gt/ (with clear.exr and transmission.exr when
-/// the scene has a medium) for one render into `dir`.
+/// images behind the four micro-polarizers) and gt/ (with clear.exr, transmission.exr and
+/// dehazed.exr when the scene has a medium) for one render into `dir`.
 /// `scene_meta` is recorded verbatim as `meta.scene` (the sample parameters or the scene file).
 /// The sensor noise is seeded from the scene's render seed.
 pub fn write_sample(
@@ -163,10 +168,12 @@ pub fn write_sample(
         .map_err(io_err(id))?;
     polar_io::write_gray8_png(gt.join("material.png"), &out.material).map_err(io_err(id))?;
     polar_io::write_gray8_png(gt.join("transparent.png"), &out.transparent).map_err(io_err(id))?;
-    // Samples with a medium: the medium-free view and the transmittance, for dehazing.
+    // Samples with a medium: the medium-free view, the transmittance and the view with
+    // the medium off the camera rays only, for dehazing.
     for (name, image) in [
         (polar_io::files::GT_CLEAR, &out.clear),
         (polar_io::files::GT_TRANSMISSION, &out.transmission),
+        (polar_io::files::GT_DEHAZED, &out.dehazed),
     ] {
         if let Some(image) = image {
             polar_io::write_exr(dir.join(name), image, polar_io::Y_CHANNEL).map_err(io_err(id))?;

@@ -1,5 +1,5 @@
 //! The sample directory of `conventions.md`: `meta.json` (required) plus optional `raw.png`,
-//! `stokes.exr` and `gt/{normal,depth,clear,transmission}.exr`, `gt/{material,transparent}.png`.
+//! `stokes.exr` and `gt/{normal,depth,clear,transmission,dehazed}.exr`, `gt/{material,transparent}.png`.
 //! Reading checks every file against the format's rules and that all images share one size;
 //! writing checks the same, then writes the whole directory atomically.
 
@@ -37,6 +37,10 @@ pub mod files {
     /// Float32 Y in `[0, 1]`: transmittance of the medium along each pixel's central ray to
     /// the first surface (an addition of this project, for dehazing).
     pub const GT_TRANSMISSION: &str = "gt/transmission.exr";
+    /// Float32 Y: S0 of the same view with the medium removed from the camera rays only
+    /// (no attenuation, no airlight up to the first surface), the objects still lit
+    /// through the medium: what dehazing recovers (an addition of this project).
+    pub const GT_DEHAZED: &str = "gt/dehazed.exr";
 
     /// What `polar-vision` writes into its output directory (docs/conventions.md).
     pub mod vision {
@@ -105,6 +109,8 @@ pub struct GroundTruth {
     pub clear: Option<Gray<f32>>,
     /// `gt/transmission.exr`.
     pub transmission: Option<Gray<f32>>,
+    /// `gt/dehazed.exr`.
+    pub dehazed: Option<Gray<f32>>,
 }
 
 /// One sample directory in memory.
@@ -127,7 +133,7 @@ pub fn read_sample(dir: impl AsRef<Path>) -> Result<Sample> {
 
 /// Reads a sample directory. `meta.json` must exist and hold a JSON object; every other file
 /// is read if present. With [`Validation::Check`]: S0 finite and `>= 0`, S1..S3, normals,
-/// depth and clear S0 finite (depth and clear also `>= 0`), transmission in `[0, 1]`,
+/// depth, clear and dehazed S0 finite (and `>= 0`), transmission in `[0, 1]`,
 /// material labels in 0..=3, the transparency mask 0 or 255. Mosaic size and equal sizes across files are always checked.
 pub fn read_sample_with(dir: impl AsRef<Path>, validation: Validation) -> Result<Sample> {
     let dir = dir.as_ref();
@@ -186,6 +192,9 @@ fn read_gt_files(dir: &Path) -> Result<GroundTruth> {
             .map(|p| read_exr(p, Y_CHANNEL))
             .transpose()?,
         transmission: opt(files::GT_TRANSMISSION)?
+            .map(|p| read_exr(p, Y_CHANNEL))
+            .transpose()?,
+        dehazed: opt(files::GT_DEHAZED)?
             .map(|p| read_exr(p, Y_CHANNEL))
             .transpose()?,
     })
@@ -282,6 +291,7 @@ fn check_sample(dir: &Path, s: &Sample, validation: Validation) -> Result<()> {
             files::GT_TRANSMISSION,
             gt.transmission.as_ref().map(Image::size),
         ),
+        (files::GT_DEHAZED, gt.dehazed.as_ref().map(Image::size)),
     ];
     for (name, size) in other_files {
         if let Some(size) = size {
@@ -312,6 +322,7 @@ fn check_values(dir: &Path, s: &Sample) -> Result<()> {
         (files::GT_DEPTH, &gt.depth, FiniteNonNegative),
         (files::GT_CLEAR, &gt.clear, FiniteNonNegative),
         (files::GT_TRANSMISSION, &gt.transmission, UnitInterval),
+        (files::GT_DEHAZED, &gt.dehazed, FiniteNonNegative),
     ] {
         if let Some(image) = image {
             check_channels(&dir.join(name), image, Y_CHANNEL, [rule])?;
@@ -361,7 +372,8 @@ fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
         || gt.material.is_some()
         || gt.transparent.is_some()
         || gt.clear.is_some()
-        || gt.transmission.is_some();
+        || gt.transmission.is_some()
+        || gt.dehazed.is_some();
     let mkdir = |p: &Path| std::fs::create_dir(p).map_err(|e| Error::io(p, "directory", e));
     mkdir(tmp)?;
     if has_gt {
@@ -382,6 +394,7 @@ fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
         (files::GT_DEPTH, &gt.depth),
         (files::GT_CLEAR, &gt.clear),
         (files::GT_TRANSMISSION, &gt.transmission),
+        (files::GT_DEHAZED, &gt.dehazed),
     ] {
         if let Some(image) = image {
             write_exr(p(name), image, Y_CHANNEL)?;

@@ -49,6 +49,7 @@ fn full_sample() -> Sample {
             transparent: Some(Gray::from_vec(W, H, mask).unwrap()),
             clear: Some(Gray::from_vec(W, H, vec![0.75; W * H]).unwrap()),
             transmission: Some(Gray::from_vec(W, H, vec![0.5; W * H]).unwrap()),
+            dehazed: Some(Gray::from_vec(W, H, vec![0.625; W * H]).unwrap()),
         },
     }
 }
@@ -72,6 +73,7 @@ fn full_sample_round_trip_is_exact() {
         files::GT_NORMAL,
         files::GT_CLEAR,
         files::GT_TRANSMISSION,
+        files::GT_DEHAZED,
     ] {
         assert!(dir.join(f).is_file(), "{f}");
     }
@@ -233,6 +235,8 @@ fn invalid_ground_truth_values_are_refused_on_write() {
     bad_mask.gt.transparent.as_mut().unwrap().as_mut_slice()[0] = 1;
     let mut neg_depth = full_sample();
     neg_depth.gt.depth.as_mut().unwrap().as_mut_slice()[0] = -1.0;
+    let mut neg_dehazed = full_sample();
+    neg_dehazed.gt.dehazed.as_mut().unwrap().as_mut_slice()[3] = -0.5;
     // Transmittance above 1 (and NaN) is not a transmittance.
     let mut over_one = full_sample();
     over_one.gt.transmission.as_mut().unwrap().as_mut_slice()[2] = 1.01;
@@ -250,6 +254,7 @@ fn invalid_ground_truth_values_are_refused_on_write() {
         (bad_label, files::GT_MATERIAL),
         (bad_mask, files::GT_TRANSPARENT),
         (neg_depth, files::GT_DEPTH),
+        (neg_dehazed, files::GT_DEHAZED),
     ] {
         match write_sample(&target, &s).unwrap_err() {
             Error::InvalidValue { path, .. } => assert!(path.ends_with(file), "{path:?}"),

@@ -77,6 +77,7 @@ fn bench(c: &mut Criterion) {
     for (name, scene, model) in cases {
         let opts = RenderOptions {
             force_model: Some(model),
+            ..Default::default()
         };
         group.bench_function(name, |b| {
             b.iter(|| render(scene, &opts, &|_, _| {}).expect("render"))

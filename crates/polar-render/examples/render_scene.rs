@@ -1,5 +1,5 @@
 //! Renders a scene file and writes `stokes.exr`, the ground truth under `gt/`
-//! (with a medium also `gt/clear.exr` and `gt/transmission.exr`) and
+//! (with a medium also `gt/clear.exr`, `gt/transmission.exr` and `gt/dehazed.exr`) and
 //! `meta.json` (with the render time in `seconds`) into OUT_DIR.
 //!
 //! `cargo run --release -p polar-render --example render_scene -- SCENE OUT_DIR [--spp N] [--model none|linear|full] [--sampler sobol|independent]`
@@ -50,7 +50,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     }
     let out_img = render(
         &scene,
-        &RenderOptions { force_model: model },
+        &RenderOptions {
+            force_model: model,
+            dehazed: true,
+        },
         &|done, total| {
             eprint!("\r{done}/{total} tiles");
         },
@@ -75,8 +78,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     polar_io::write_gray8_png(out.join("gt/material.png"), &out_img.material)?;
     polar_io::write_gray8_png(out.join("gt/transparent.png"), &out_img.transparent)?;
     for (name, image) in [
-        ("gt/clear.exr", &out_img.clear),
-        ("gt/transmission.exr", &out_img.transmission),
+        (polar_io::files::GT_CLEAR, &out_img.clear),
+        (polar_io::files::GT_TRANSMISSION, &out_img.transmission),
+        (polar_io::files::GT_DEHAZED, &out_img.dehazed),
     ] {
         if let Some(image) = image {
             polar_io::write_exr(out.join(name), image, polar_io::Y_CHANNEL)?;

@@ -516,7 +516,7 @@ impl<R: Transport> Path<R> {
         let path_frame = |x: Option<Vec3>| x.unwrap_or_else(|| world.camera.film_frame(d0));
         let (o, d, depth) = (self.o, self.d, self.depth);
         let hit = world.intersect(&o, &d);
-        let mut vertex = match world.flight(&o, &d, hit.as_ref(), sampler) {
+        let mut vertex = match world.flight(&o, &d, hit.as_ref(), depth == 0, sampler) {
             Flight::Scatter { t, weight, medium } => {
                 self.throughput = Some(self.throughput.unwrap_or_else(R::identity).scaled(weight));
                 Vertex::Medium {

@@ -24,6 +24,9 @@ pub struct RenderOptions {
     /// Transport model to use instead of the cheapest exact one; must not be
     /// cheaper than the scene needs (that would be inexact).
     pub force_model: Option<Polarization>,
+    /// With a medium, also render [`RenderOutput::dehazed`] (one more render of the
+    /// view); ignored without a medium.
+    pub dehazed: bool,
 }
 
 /// Everything a render produces.
@@ -42,14 +45,22 @@ pub struct RenderOutput {
     /// S0 of the same view rendered without the participating medium (same
     /// seed and samples); `None` when the scene has no medium.
     pub clear: Option<Gray<f32>>,
+    /// S0 of the same view (same seed) with the medium removed from the camera
+    /// segment of every path only: from the camera to the first surface (or on to
+    /// the environment) there is neither extinction nor in-scattering, while the
+    /// light reaching that surface still crosses the medium (attenuated sun,
+    /// skylight scattered by the haze). What dehazing recovers: the hazy image is
+    /// `t · dehazed + airlight` with `t` the camera segment's transmittance.
+    /// `None` unless asked for ([`RenderOptions::dehazed`]) and the scene has a medium.
+    pub dehazed: Option<Gray<f32>>,
     /// Transmittance `exp(−∫ σ_t ds)` of the medium along each pixel's central ray
     /// up to its first surface (to the medium's exit if none), computed exactly;
     /// `None` when the scene has no medium.
     pub transmission: Option<Gray<f32>>,
     /// The transport model used.
     pub model: Polarization,
-    /// Wall-clock seconds of the render (BVH build included; the medium-free
-    /// render behind `clear` excluded).
+    /// Wall-clock seconds of the render (BVH build included; the renders behind
+    /// `clear` and `dehazed` excluded).
     pub seconds: f64,
     /// Samples per pixel.
     pub spp: u32,
@@ -103,7 +114,8 @@ struct GroundTruth {
 
 /// Renders `scene` with the cheapest exact transport (or `opts.force_model`),
 /// using the current rayon thread pool. `progress(done, total)` is called after each tile
-/// (with a medium, a second round follows for the medium-free `clear` render).
+/// (with a medium, a second round follows for the medium-free `clear` render, and a
+/// third for `dehazed` when asked for).
 /// The result is bit-identical for the same scene and seed whatever the thread count.
 pub fn render(
     scene: &Scene,
@@ -120,7 +132,7 @@ pub fn render(
         });
     }
     let start = Instant::now();
-    let tiles = render_with(scene, model, progress);
+    let tiles = render_with(scene, model, false, progress);
     let seconds = start.elapsed().as_secs_f64();
     let mut out = assemble(scene, tiles, model, seconds);
     if scene.medium.is_some() {
@@ -131,33 +143,45 @@ pub fn render(
         let clear_model = opts.force_model.unwrap_or(required_model(&clear_scene));
         let clear = assemble(
             &clear_scene,
-            render_with(&clear_scene, clear_model, progress),
+            render_with(&clear_scene, clear_model, false, progress),
             clear_model,
             0.0,
         );
         out.clear = Some(clear.stokes.channel(0));
+        if opts.dehazed {
+            let dehazed = assemble(scene, render_with(scene, model, true, progress), model, 0.0);
+            out.dehazed = Some(dehazed.stokes.channel(0));
+        }
     }
     Ok(out)
 }
 
 /// Renders the tiles of a validated scene with transport `model`, on the best
-/// SIMD target of the CPU.
+/// SIMD target of the CPU; `camera_segment_clear` takes the medium off the camera
+/// segment of every path (the dehazed ground truth).
 fn render_with(
     scene: &Scene,
     model: Polarization,
+    camera_segment_clear: bool,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<TileResult> {
-    render_on(scene, model, Arch::new(), progress)
+    render_on(scene, model, camera_segment_clear, Arch::new(), progress)
 }
 
 /// [`render_with`] on the SIMD target `arch`.
 fn render_on(
     scene: &Scene,
     model: Polarization,
+    camera_segment_clear: bool,
     arch: Arch,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<TileResult> {
     let world = World::new(scene);
+    let world = if camera_segment_clear {
+        world.with_camera_segment_clear()
+    } else {
+        world
+    };
     match model {
         Polarization::None => render_tiles::<Scalar>(&world, arch, progress),
         Polarization::Linear => render_tiles::<Linear>(&world, arch, progress),
@@ -337,6 +361,7 @@ fn assemble(
         material,
         transparent,
         clear: None,
+        dehazed: None,
         transmission: scene.medium.is_some().then_some(transmission),
         model,
         seconds,
@@ -353,7 +378,7 @@ mod tests {
     /// The bits of the Stokes image of `scene` rendered on the SIMD target `arch`.
     fn stokes_bits(scene: &Scene, arch: Arch) -> Vec<u32> {
         let model = required_model(scene);
-        let tiles = render_on(scene, model, arch, &|_, _| {});
+        let tiles = render_on(scene, model, false, arch, &|_, _| {});
         let out = assemble(scene, tiles, model, 0.0);
         out.stokes.as_slice().iter().map(|v| v.to_bits()).collect()
     }

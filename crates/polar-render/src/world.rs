@@ -67,6 +67,10 @@ pub(crate) struct World<'a> {
     environment: Option<Environment<'a>>,
     /// Index in `lights` of each emissive shape (for MIS when a BSDF ray hits it).
     area_index: Vec<Option<usize>>,
+    /// `true` for the dehazed ground truth: the camera segment of every path (camera to
+    /// its first surface, or on to the environment) passes the medium without
+    /// interacting; every later segment and every shadow ray still does.
+    camera_segment_clear: bool,
 }
 
 /// What the light draw of a vertex picks among the lights with extent.
@@ -136,6 +140,16 @@ impl<'a> World<'a> {
             suns,
             environment,
             area_index,
+            camera_segment_clear: false,
+        }
+    }
+
+    /// This world with the camera segment of every path free of the medium (see
+    /// [`crate::RenderOptions::dehazed`]).
+    pub fn with_camera_segment_clear(self) -> Self {
+        Self {
+            camera_segment_clear: true,
+            ..self
         }
     }
 
@@ -148,21 +162,23 @@ impl<'a> World<'a> {
 
     /// The first scattering event along `o + t d` before the surface `hit` (if any),
     /// or passing through (always `Pass` with weight 1, drawing no random numbers,
-    /// without a medium: the distance to the hit is only computed with one).
+    /// without a medium, or on the `camera_segment` of a world whose camera segment
+    /// is clear: the distance to the hit is only computed with one).
     #[inline(always)]
     pub fn flight(
         &self,
         o: &Vec3,
         d: &Vec3,
         hit: Option<&SurfaceHit>,
+        camera_segment: bool,
         sampler: &mut Sampler,
     ) -> Flight<'a> {
         match &self.scene.medium {
-            Some(m) => {
+            Some(m) if !(camera_segment && self.camera_segment_clear) => {
                 let t_max = hit.map_or(f64::INFINITY, |h| (h.p - o).norm());
                 tracking::flight(m, o, d, t_max, sampler)
             }
-            None => Flight::Pass { weight: 1.0 },
+            _ => Flight::Pass { weight: 1.0 },
         }
     }
 

@@ -147,6 +147,7 @@ fn cheaper_model_than_needed_is_refused() {
         &scene(glass),
         &RenderOptions {
             force_model: Some(Polarization::Linear),
+            ..Default::default()
         },
         &|_, _| {},
     )

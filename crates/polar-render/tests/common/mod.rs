@@ -20,7 +20,20 @@ pub fn camera(distance: f64, fov_deg: f64, size: usize) -> Camera {
 
 /// Renders silently, with the cheapest exact model or the one forced.
 pub fn run(scene: &Scene, model: Option<Polarization>) -> RenderOutput {
-    render(scene, &RenderOptions { force_model: model }, &|_, _| {}).expect("render")
+    let opts = RenderOptions {
+        force_model: model,
+        ..Default::default()
+    };
+    render(scene, &opts, &|_, _| {}).expect("render")
+}
+
+/// Renders silently with the cheapest exact model, with the dehazed ground truth.
+pub fn run_dehazed(scene: &Scene) -> RenderOutput {
+    let opts = RenderOptions {
+        dehazed: true,
+        ..Default::default()
+    };
+    render(scene, &opts, &|_, _| {}).expect("render")
 }
 
 /// Renders on a pool of `threads` threads.
