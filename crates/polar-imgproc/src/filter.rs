@@ -268,7 +268,8 @@ fn row_box_sum(pad: &[f32], kw: usize, out: &mut [f64]) {
     let seg = w.div_ceil(SEG);
     let start = |j: usize| (j * seg).min(w);
     let mut acc = [0.0f64; SEG];
-    for (j, a) in acc.iter_mut().enumerate() {
+    // Segments past the row's end are empty (narrow rows): nothing to start there.
+    for (j, a) in acc.iter_mut().enumerate().filter(|&(j, _)| start(j) < w) {
         *a = pad[start(j)..start(j) + kw]
             .iter()
             .map(|&v| f64::from(v))
@@ -363,6 +364,32 @@ pub fn scharr(src: &Gray<f32>, dst: &mut Gray<f32>, dx: usize, dy: usize) -> Res
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wide_box_on_narrow_images_matches_the_direct_sum() {
+        // Regression: windows wider than 9 on rows of 1, 2, 3, 5, 6 or 9 pixels indexed
+        // past the padded row (an empty fourth segment).
+        for w in 1..12 {
+            let src = Gray::from_vec(w, 3, (0..3 * w).map(|i| i as f32).collect()).unwrap();
+            let mut dst = Gray::new(w, 3);
+            box_filter(&src, &mut dst, 11, 1, Border::Reflect101).unwrap();
+            for y in 0..3 {
+                for x in 0..w {
+                    let sum: f32 = (-5..=5)
+                        .map(|d| {
+                            src.as_slice()[y * w + Border::Reflect101.index(x as isize + d, w)]
+                        })
+                        .sum();
+                    let got = dst.as_slice()[y * w + x];
+                    assert!(
+                        (got - sum / 11.0).abs() < 1e-4,
+                        "w {w} ({x},{y}): {got} vs {}",
+                        sum / 11.0
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn gaussian_kernel_fixed_tables_and_formula() {
