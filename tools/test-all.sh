@@ -29,6 +29,16 @@ step "image primitives vs opencv-contrib / scikit-image"
 step "task metrics vs numpy / scikit-image"
 "$py" tools/eval_goldens.py --check
 
+step "dark-channel dehazing vs OpenCV (regenerated goldens equal the committed ones)"
+tmp="$(mktemp -d)"
+"$py" tools/dehaze_dcp_reference.py "$tmp/s0.bin" --synthetic 64 48 --width 64 --height 48 \
+    --out-t "$tmp/t.bin" --out-radiance "$tmp/radiance.bin"
+golden=crates/polar-dehaze/tests/golden
+cmp "$golden/dcp_s0.bin" "$tmp/s0.bin"
+cmp "$golden/dcp_t.bin" "$tmp/t.bin"
+cmp "$golden/dcp_radiance.bin" "$tmp/radiance.bin"
+rm -rf "$tmp"
+
 step "front end vs polanalyser"
 "$py" tools/polanalyser_goldens.py --check
 

@@ -25,7 +25,10 @@ impl Golden {
 
     fn f32(&self, name: &str) -> Gray<f32> {
         let v = self.data["inputs"][name].as_array().unwrap();
-        let v = v.iter().map(|x| x.as_f64().map_or(f32::NAN, |x| x as f32)).collect();
+        let v = v
+            .iter()
+            .map(|x| x.as_f64().map_or(f32::NAN, |x| x as f32))
+            .collect();
         Gray::from_vec(self.w, self.h, v).unwrap()
     }
 
@@ -59,18 +62,43 @@ fn depth_fit_matches_numpy_polyfit() {
     assert_eq!(fit.count as f64, g.expected("depth.count"));
     assert_rel(fit.scale, g.expected("depth.scale"), 1e-9, "scale");
     assert_rel(fit.offset, g.expected("depth.offset"), 1e-9, "offset");
-    assert_rel(fit.relative_rmse, g.expected("depth.relative_rmse"), 1e-9, "rmse");
+    assert_rel(
+        fit.relative_rmse,
+        g.expected("depth.relative_rmse"),
+        1e-9,
+        "rmse",
+    );
 }
 
 #[test]
 fn mask_metrics_match_numpy() {
     let g = Golden::load();
-    let m = mask_metrics(&g.u8("pred_mask"), &g.u8("truth_mask"), Some(&g.u8("distractors"))).unwrap();
+    let m = mask_metrics(
+        &g.u8("pred_mask"),
+        &g.u8("truth_mask"),
+        Some(&g.u8("distractors")),
+    )
+    .unwrap();
     assert_rel(m.iou.unwrap(), g.expected("mask.iou"), 1e-12, "iou");
-    assert_rel(m.precision.unwrap(), g.expected("mask.precision"), 1e-12, "precision");
-    assert_rel(m.recall.unwrap(), g.expected("mask.recall"), 1e-12, "recall");
+    assert_rel(
+        m.precision.unwrap(),
+        g.expected("mask.precision"),
+        1e-12,
+        "precision",
+    );
+    assert_rel(
+        m.recall.unwrap(),
+        g.expected("mask.recall"),
+        1e-12,
+        "recall",
+    );
     let fp = m.false_positive_on_distractors.unwrap();
-    assert_rel(fp, g.expected("mask.false_positive_on_distractors"), 1e-12, "fp");
+    assert_rel(
+        fp,
+        g.expected("mask.false_positive_on_distractors"),
+        1e-12,
+        "fp",
+    );
 }
 
 #[test]
@@ -78,13 +106,27 @@ fn material_metrics_match_numpy() {
     let g = Golden::load();
     let m = material_metrics(&g.u8("pred_labels"), &g.u8("truth_labels")).unwrap();
     let acc = m.metal_vs_dielectric_accuracy.unwrap();
-    assert_rel(acc, g.expected("material.metal_vs_dielectric_accuracy"), 1e-12, "fg accuracy");
-    assert_rel(m.pixel_accuracy.unwrap(), g.expected("material.pixel_accuracy"), 1e-12, "accuracy");
+    assert_rel(
+        acc,
+        g.expected("material.metal_vs_dielectric_accuracy"),
+        1e-12,
+        "fg accuracy",
+    );
+    assert_rel(
+        m.pixel_accuracy.unwrap(),
+        g.expected("material.pixel_accuracy"),
+        1e-12,
+        "accuracy",
+    );
     for c in 0..4 {
-        let want = g.data["expected"]["material"]["class_iou"][c].as_f64().unwrap();
+        let want = g.data["expected"]["material"]["class_iou"][c]
+            .as_f64()
+            .unwrap();
         assert_rel(m.class_iou[c].unwrap(), want, 1e-12, "class iou");
         for p in 0..4 {
-            let want = g.data["expected"]["material"]["confusion"][c][p].as_u64().unwrap();
+            let want = g.data["expected"]["material"]["confusion"][c][p]
+                .as_u64()
+                .unwrap();
             assert_eq!(m.confusion[c][p], want, "confusion[{c}][{p}]");
         }
     }
@@ -94,13 +136,48 @@ fn material_metrics_match_numpy() {
 fn dehaze_metrics_match_scikit_image_and_numpy() {
     let g = Golden::load();
     let (t_est, t_gt) = (g.f32("t_est"), g.f32("t_gt"));
-    let m = dehaze_metrics(&g.f32("hazy"), &g.f32("dehazed"), &g.f32("reference"), Some((&t_est, &t_gt)))
-        .unwrap();
-    assert_rel(m.hazy.psnr_db, g.expected("dehaze.hazy.psnr_db"), 1e-6, "hazy psnr");
-    assert_rel(m.dehazed.psnr_db, g.expected("dehaze.dehazed.psnr_db"), 1e-6, "psnr");
-    assert_rel(m.hazy.ssim, g.expected("dehaze.hazy.ssim"), 1e-5, "hazy ssim");
-    assert_rel(m.dehazed.ssim, g.expected("dehaze.dehazed.ssim"), 1e-5, "ssim");
-    assert_rel(m.transmission_mae.unwrap(), g.expected("dehaze.transmission_mae"), 1e-9, "mae");
+    let m = dehaze_metrics(
+        &g.f32("hazy"),
+        &g.f32("dehazed"),
+        &g.f32("reference"),
+        Some((&t_est, &t_gt)),
+    )
+    .unwrap();
+    assert_rel(
+        m.hazy.psnr_db,
+        g.expected("dehaze.hazy.psnr_db"),
+        1e-6,
+        "hazy psnr",
+    );
+    assert_rel(
+        m.dehazed.psnr_db,
+        g.expected("dehaze.dehazed.psnr_db"),
+        1e-6,
+        "psnr",
+    );
+    assert_rel(
+        m.hazy.ssim,
+        g.expected("dehaze.hazy.ssim"),
+        1e-5,
+        "hazy ssim",
+    );
+    assert_rel(
+        m.dehazed.ssim,
+        g.expected("dehaze.dehazed.ssim"),
+        1e-5,
+        "ssim",
+    );
+    assert_rel(
+        m.transmission_mae.unwrap(),
+        g.expected("dehaze.transmission_mae"),
+        1e-9,
+        "mae",
+    );
     let corr = m.transmission_correlation.unwrap();
-    assert_rel(corr, g.expected("dehaze.transmission_correlation"), 1e-9, "correlation");
+    assert_rel(
+        corr,
+        g.expected("dehaze.transmission_correlation"),
+        1e-9,
+        "correlation",
+    );
 }

@@ -24,12 +24,12 @@
 mod filter;
 mod guided;
 mod label;
+pub mod mask;
 mod median;
 mod metrics;
 mod morph;
 mod threshold;
 
-pub use polar_image::Border;
 pub use filter::{
     box_filter, gaussian_blur, gaussian_kernel, scharr, sep_filter, sobel, sobel_kernels,
 };
@@ -38,6 +38,7 @@ pub use label::{ComponentStats, Connectivity, component_stats, label};
 pub use median::{median_blur, median_blur_u8};
 pub use metrics::{AngularErrorStats, ConfusionMatrix, angular_error, iou, psnr, ssim, ssim_map};
 pub use morph::{MorphShape, close, dilate, erode, max_filter, min_filter, open};
+pub use polar_image::Border;
 pub use threshold::{threshold_otsu, threshold_otsu_u8};
 
 use thiserror::Error;

@@ -29,6 +29,7 @@ pub mod frame;
 pub mod fresnel;
 pub mod mueller;
 pub mod pixel_frame;
+pub mod reflection_dolp;
 pub mod scatter;
 pub mod sky;
 pub mod stokes;

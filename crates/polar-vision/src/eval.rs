@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use polar_eval::{Aggregate, SCHEMA_VERSION, Summary, aggregate};
+use polar_eval::{Aggregate, SCHEMA_VERSION, Summary, aggregate, family_of};
 use polar_io::Shard;
 use polar_io::files;
 use rayon::prelude::*;
@@ -43,6 +43,10 @@ pub struct EvalArgs {
     /// Evaluate only shard K of N (1-based).
     #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
+    /// Evaluate only the samples of these families (a sample folder's name without its
+    /// trailing `-<digits>`, e.g. `sfp` for `sfp-00012`), comma-separated. Default: all.
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub family: Vec<String>,
 }
 
 /// `run`'s options as `eval` takes them (the sample comes from the dataset).
@@ -109,7 +113,13 @@ pub struct EvalReport {
 
 /// Runs the subcommand; `Ok(false)` when a sample or a task failed.
 pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
-    let samples = list_samples(&args.dataset)?;
+    let mut samples = list_samples(&args.dataset)?;
+    if !args.family.is_empty() {
+        samples.retain(|s| args.family.iter().any(|f| f == family_of(&sample_name(s))));
+        if samples.is_empty() {
+            return Err(CliError::NoSamples(args.dataset.clone()));
+        }
+    }
     let shard = args.shard.unwrap_or(Shard::ALL);
     let mine: Vec<&PathBuf> = samples
         .iter()
@@ -267,7 +277,7 @@ fn write_report(
 }
 
 /// The headline figures of each task, in the order a reader looks for them.
-const HEADLINES: [(&str, &str, &str); 9] = [
+const HEADLINES: [(&str, &str, &str); 10] = [
     ("sfp", "normal.mean_deg", "mean angular error (deg)"),
     ("sfp", "normal.median_deg", "median angular error (deg)"),
     ("sfp", "normal.depth.relative_rmse", "depth RMSE / range"),
@@ -282,11 +292,24 @@ const HEADLINES: [(&str, &str, &str); 9] = [
         "false_positive_on_distractors",
         "false positives on opaque objects",
     ),
-    ("dehaze", "dehazed.psnr_db", "dehazed PSNR (dB)"),
-    ("dehaze", "hazy.psnr_db", "hazy input PSNR (dB)"),
     (
         "dehaze",
-        "transmission_correlation",
+        "against_dehazed.dehazed.psnr_db",
+        "dehazed PSNR vs gt/dehazed (dB)",
+    ),
+    (
+        "dehaze",
+        "against_dehazed.hazy.psnr_db",
+        "hazy PSNR vs gt/dehazed (dB)",
+    ),
+    (
+        "dehaze",
+        "against_clear.dehazed.psnr_db",
+        "dehazed PSNR vs gt/clear (dB)",
+    ),
+    (
+        "dehaze",
+        "against_dehazed.transmission_correlation",
         "transmission correlation",
     ),
 ];

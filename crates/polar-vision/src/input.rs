@@ -107,8 +107,12 @@ pub fn resolve(path: &Path, source: Option<Source>) -> Result<InputFile, CliErro
     }
 }
 
-/// Reads `file` into an observation (camera orthographic; see [`camera_model`]).
-pub fn read_observation(file: &InputFile, args: &InputArgs) -> Result<Observation, CliError> {
+/// Reads `file` into an observation (camera orthographic; see [`camera_model`]), with
+/// warnings for the user (e.g. saturated pixels, which are flagged).
+pub fn read_observation(
+    file: &InputFile,
+    args: &InputArgs,
+) -> Result<(Observation, Vec<String>), CliError> {
     match file {
         InputFile::Raw(path) => {
             let bits = args.bit_depth.as_deref().map(|b| {
@@ -118,15 +122,16 @@ pub fn read_observation(file: &InputFile, args: &InputArgs) -> Result<Observatio
             let png = polar_io::read_mosaic(path)?;
             let (raw, bits) = significant_bits(path, png, bits, args.align)?;
             let level = saturation_level(&raw, bits);
-            check_exposure(path, &raw, bits, level)?;
+            let warning = check_exposure(path, &raw, bits, level)?;
             let planes = stokes_planes(&raw, args.demosaic)?;
             let flags = validity_mask(&raw, level, args.demosaic, &planes.s0);
-            Ok(Observation::new(planes, CameraModel::Orthographic).with_flags(flags))
+            let obs = Observation::new(planes, CameraModel::Orthographic).with_flags(flags);
+            Ok((obs, warning.into_iter().collect()))
         }
         InputFile::Stokes(path) => {
             let stokes = polar_io::read_exr(path, LINEAR_STOKES_CHANNELS)?;
             let planes = StokesPlanes::from_linear_stokes(&stokes);
-            Ok(Observation::new(planes, CameraModel::Orthographic))
+            Ok((Observation::new(planes, CameraModel::Orthographic), vec![]))
         }
     }
 }
@@ -222,8 +227,13 @@ fn significant_bits(
     Ok((raw, bits))
 }
 
-/// Rejects frames without usable light; warns about partly saturated ones.
-fn check_exposure(path: &Path, raw: &Gray<u16>, bits: u8, level: u32) -> Result<(), CliError> {
+/// Rejects frames without usable light; a warning for partly saturated ones.
+fn check_exposure(
+    path: &Path,
+    raw: &Gray<u16>,
+    bits: u8,
+    level: u32,
+) -> Result<Option<String>, CliError> {
     if raw.as_slice().iter().all(|&v| v == 0) {
         return Err(CliError::AllZero(path.to_owned()));
     }
@@ -236,14 +246,13 @@ fn check_exposure(path: &Path, raw: &Gray<u16>, bits: u8, level: u32) -> Result<
             bits,
         });
     }
-    if saturated > 0 {
-        eprintln!(
-            "warning: {}: {saturated} of {n} pixels ({:.3}%) are saturated at {level} DN; flagged in the mask",
+    Ok((saturated > 0).then(|| {
+        format!(
+            "{}: {saturated} of {n} pixels ({:.3}%) are saturated at {level} DN; flagged in the mask",
             path.display(),
             100.0 * saturated as f64 / n as f64
-        );
-    }
-    Ok(())
+        )
+    }))
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::CliError;
 use crate::input::{InputArgs, InputFile, Source, camera_model, read_observation, resolve};
-use crate::stokes::{prepare_out, write_outputs};
+use crate::stokes::{Output, check_out_apart, prepare_out, write_outputs};
 use crate::task_options::TaskArgs;
 use crate::tasks::{Context, Failure, Task};
 
@@ -64,6 +64,8 @@ pub struct SampleReport {
     pub size: [usize; 2],
     /// Seconds to read and demosaic.
     pub read_seconds: f64,
+    /// Warnings about the input (e.g. saturated pixels).
+    pub warnings: Vec<String>,
     /// Per task: status, messages, time and metrics.
     pub tasks: BTreeMap<String, Summary>,
 }
@@ -84,6 +86,10 @@ pub fn run(args: &RunArgs) -> Result<bool, CliError> {
             .map_err(|e| CliError::Threads(e.to_string()))?;
     }
     let report = run_sample(&args.sample, &args.out, args)?;
+    report
+        .warnings
+        .iter()
+        .for_each(|w| eprintln!("warning: {w}"));
     for (task, s) in &report.tasks {
         let status = if s.ok { "ok" } else { "FAILED" };
         eprintln!("{task}: {status} in {:.3} s", s.seconds);
@@ -98,11 +104,12 @@ pub fn run(args: &RunArgs) -> Result<bool, CliError> {
 /// the report (also written as `metrics.json` where the sample has ground truth).
 pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleReport, CliError> {
     let file = resolve(sample, args.input)?;
+    check_out_apart(sample, out)?;
     prepare_out(out)?;
     let start = Instant::now();
     let dir = sample.is_dir().then_some(sample);
     let meta = dir.map(polar_io::read_optional_meta).transpose()?.flatten();
-    let mut obs = read_observation(&file, &args.read)?;
+    let (mut obs, warnings) = read_observation(&file, &args.read)?;
     obs.camera = camera_model(args.task.fov, meta.as_ref());
     let gt = match dir {
         Some(d) => polar_io::read_ground_truth(d, Validation::Check)?,
@@ -111,13 +118,14 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
     check_gt_size(sample, &gt, obs.size())?;
     let read_seconds = start.elapsed().as_secs_f64();
     let raw_mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
-    write_outputs(out, &obs.planes, raw_mask)?;
+    write_outputs(out, &obs.planes, raw_mask, &Output::ALL)?;
     std::fs::create_dir_all(out.join(vision::PICTURES))
         .map_err(|e| CliError::write(out.join(vision::PICTURES), e))?;
     let mut ctx = Context {
         obs: &obs,
         gt: &gt,
         out,
+        radiance_per_unit: radiance_per_unit(&file, dir, &obs, &gt)?,
         normals: None,
         transparent: None,
     };
@@ -152,12 +160,48 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
         input: file_name(&file),
         size: [w, h],
         read_seconds,
+        warnings,
         tasks,
     };
     if has_any(&gt) {
         polar_io::write_json(out.join(vision::METRICS), &report)?;
     }
     Ok(report)
+}
+
+/// The factor from the observation's unit to the ground truth's radiance, for metrics that
+/// compare intensities (dehazing): 1 for `stokes.exr` input; for a raw mosaic, the least
+/// squares gain from its S0 to the sample's `stokes.exr` S0 over valid pixels (a camera
+/// frame is in DN, the truth in radiance). `None` where neither tells.
+fn radiance_per_unit(
+    file: &InputFile,
+    dir: Option<&Path>,
+    obs: &polar_sensor::Observation,
+    gt: &GroundTruth,
+) -> Result<Option<f64>, CliError> {
+    let stokes = dir.map(|d| d.join(vision::STOKES)).filter(|p| p.is_file());
+    match (file, stokes) {
+        (InputFile::Stokes(_), _) => Ok(Some(1.0)),
+        (InputFile::Raw(_), Some(path)) if gt.clear.is_some() || gt.dehazed.is_some() => {
+            let truth = polar_io::read_exr_channel(&path, "S0")?;
+            let (mut xy, mut xx) = (0.0, 0.0);
+            for (k, (&x, &y)) in obs
+                .planes
+                .s0
+                .as_slice()
+                .iter()
+                .zip(truth.as_slice())
+                .enumerate()
+            {
+                if obs.is_valid(k) && y.is_finite() {
+                    xy += f64::from(x) * f64::from(y);
+                    xx += f64::from(x) * f64::from(x);
+                }
+            }
+            Ok((xx > 0.0).then(|| xy / xx))
+        }
+        _ => Ok(None),
+    }
 }
 
 fn file_name(file: &InputFile) -> String {
@@ -178,6 +222,7 @@ fn check_gt_size(sample: &Path, gt: &GroundTruth, size: (usize, usize)) -> Resul
         gt.material.as_ref().map(|i| i.size()),
         gt.transparent.as_ref().map(|i| i.size()),
         gt.clear.as_ref().map(|i| i.size()),
+        gt.dehazed.as_ref().map(|i| i.size()),
         gt.transmission.as_ref().map(|i| i.size()),
     ];
     match sizes.into_iter().flatten().find(|&s| s != size) {

@@ -3,12 +3,13 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use polar_image::Gray;
 use polar_io::files::vision;
-use polar_io::{LINEAR_STOKES_CHANNELS, Y_CHANNEL};
+use polar_io::{ExrCompression, LINEAR_STOKES_CHANNELS, Y_CHANNEL};
 use polar_sensor::StokesPlanes;
 use polar_sensor::picture::{aolp_hsv, colormap, quantile};
+use rayon::prelude::*;
 
 use crate::error::CliError;
 use crate::input::{InputArgs, InputFile, read_observation, resolve};
@@ -31,6 +32,67 @@ pub struct StokesArgs {
     /// How to read the input.
     #[command(flatten)]
     pub read: InputArgs,
+    /// Which files to write, comma-separated: stokes, dolp, aolp, pictures (aolp.png,
+    /// dolp.png, s0.png), mask. Default: all.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = Output::ALL)]
+    pub outputs: Vec<Output>,
+}
+
+/// Refuses an output folder that would overwrite the input: the input sample directory
+/// itself or a folder inside it, or the folder of an input file.
+pub fn check_out_apart(input: &Path, out: &Path) -> Result<(), CliError> {
+    let (base, inside_too) = if input.is_dir() {
+        (input.to_owned(), true)
+    } else {
+        let parent = input.parent().filter(|p| !p.as_os_str().is_empty());
+        (parent.unwrap_or(Path::new(".")).to_owned(), false)
+    };
+    let Ok(base) = base.canonicalize() else {
+        return Ok(());
+    };
+    let out_abs = absolute_existing_prefix(out);
+    let clash = if inside_too {
+        out_abs.starts_with(&base)
+    } else {
+        out_abs == base
+    };
+    if clash {
+        return Err(CliError::OutDir {
+            path: out.to_owned(),
+            reason: format!(
+                "it is {} the input {}; its files would be overwritten",
+                if out_abs == base {
+                    "the folder of"
+                } else {
+                    "inside"
+                },
+                input.display()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// `path` made absolute through its longest existing ancestor (the rest appended as is).
+fn absolute_existing_prefix(path: &Path) -> PathBuf {
+    let mut rest = Vec::new();
+    let mut p = path.to_owned();
+    loop {
+        if let Ok(c) = p.canonicalize() {
+            return rest.iter().rev().fold(c, |acc, part| acc.join(part));
+        }
+        match (p.file_name().map(|n| n.to_owned()), p.parent()) {
+            (Some(name), Some(parent)) => {
+                rest.push(name);
+                p = if parent.as_os_str().is_empty() {
+                    PathBuf::from(".")
+                } else {
+                    parent.to_owned()
+                };
+            }
+            _ => return path.to_owned(),
+        }
+    }
 }
 
 /// Creates the output directory (or checks it is one).
@@ -50,12 +112,14 @@ pub fn prepare_out(out: &Path) -> Result<(), CliError> {
 /// Runs the subcommand.
 pub fn run(args: &StokesArgs) -> Result<(), CliError> {
     let file = resolve(&args.input, None)?;
+    check_out_apart(&args.input, &args.out)?;
     prepare_out(&args.out)?;
     let start = Instant::now();
-    let obs = read_observation(&file, &args.read)?;
+    let (obs, warnings) = read_observation(&file, &args.read)?;
+    warnings.iter().for_each(|w| eprintln!("warning: {w}"));
     let mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let computed = start.elapsed();
-    write_outputs(&args.out, &obs.planes, mask)?;
+    write_outputs(&args.out, &obs.planes, mask, &args.outputs)?;
     let (w, h) = obs.size();
     eprintln!(
         "{w}x{h} ({}) in {:.1} ms, outputs in {:.1} ms -> {}",
@@ -67,25 +131,82 @@ pub fn run(args: &StokesArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Writes every output file of the subcommand into `out`.
+/// The output files of the front end, selectable with `--outputs`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Output {
+    /// stokes.exr: S0, S1, S2.
+    Stokes,
+    /// dolp.exr.
+    Dolp,
+    /// aolp.exr.
+    Aolp,
+    /// aolp.png, dolp.png, s0.png.
+    Pictures,
+    /// mask.png (raw input only).
+    Mask,
+}
+
+impl Output {
+    /// Every output: the default.
+    pub const ALL: [Output; 5] = [
+        Output::Stokes,
+        Output::Dolp,
+        Output::Aolp,
+        Output::Pictures,
+        Output::Mask,
+    ];
+}
+
+type Job<'a> = Box<dyn FnOnce() -> Result<(), polar_io::Error> + Send + 'a>;
+
+/// Writes the selected output files into `out`, encoding them in parallel. EXR files use
+/// RLE compression (lossless; float noise does not deflate much, and ZIP costs several
+/// times the time of the whole computation).
 pub fn write_outputs(
     out: &Path,
     planes: &StokesPlanes,
     mask: Option<&Gray<u8>>,
+    outputs: &[Output],
 ) -> Result<(), CliError> {
-    polar_io::write_exr(
-        out.join(vision::STOKES),
-        &planes.linear_stokes(),
-        LINEAR_STOKES_CHANNELS,
-    )?;
-    polar_io::write_exr(out.join(vision::DOLP), &planes.dolp, Y_CHANNEL)?;
-    polar_io::write_exr(out.join(vision::AOLP), &planes.aolp, Y_CHANNEL)?;
-    polar_io::write_rgb8_png(out.join("aolp.png"), &aolp_hsv(&planes.aolp, &planes.dolp))?;
-    polar_io::write_rgb8_png(out.join("dolp.png"), &colormap(&planes.dolp, 0.0, 1.0))?;
-    let s0_max = quantile(&planes.s0, 0.995).unwrap_or(1.0);
-    polar_io::write_rgb8_png(out.join("s0.png"), &colormap(&planes.s0, 0.0, s0_max))?;
-    if let Some(mask) = mask {
-        polar_io::write_gray8_png(out.join("mask.png"), mask)?;
+    let want = |o: Output| outputs.contains(&o);
+    let rle = ExrCompression::Rle;
+    let mut jobs: Vec<Job<'_>> = Vec::new();
+    if want(Output::Stokes) {
+        jobs.push(Box::new(move || {
+            let img = planes.linear_stokes();
+            polar_io::write_exr_with(out.join(vision::STOKES), &img, LINEAR_STOKES_CHANNELS, rle)
+        }));
     }
+    if want(Output::Dolp) {
+        jobs.push(Box::new(move || {
+            polar_io::write_exr_with(out.join(vision::DOLP), &planes.dolp, Y_CHANNEL, rle)
+        }));
+    }
+    if want(Output::Aolp) {
+        jobs.push(Box::new(move || {
+            polar_io::write_exr_with(out.join(vision::AOLP), &planes.aolp, Y_CHANNEL, rle)
+        }));
+    }
+    if want(Output::Pictures) {
+        jobs.push(Box::new(move || {
+            let hsv = aolp_hsv(&planes.aolp, &planes.dolp);
+            polar_io::write_rgb8_png(out.join("aolp.png"), &hsv)
+        }));
+        jobs.push(Box::new(move || {
+            polar_io::write_rgb8_png(out.join("dolp.png"), &colormap(&planes.dolp, 0.0, 1.0))
+        }));
+        jobs.push(Box::new(move || {
+            let s0_max = quantile(&planes.s0, 0.995).unwrap_or(1.0);
+            polar_io::write_rgb8_png(out.join("s0.png"), &colormap(&planes.s0, 0.0, s0_max))
+        }));
+    }
+    if let Some(mask) = mask.filter(|_| want(Output::Mask)) {
+        jobs.push(Box::new(move || {
+            polar_io::write_gray8_png(out.join("mask.png"), mask)
+        }));
+    }
+    jobs.into_par_iter()
+        .map(|job| job())
+        .collect::<Result<(), _>>()?;
     Ok(())
 }

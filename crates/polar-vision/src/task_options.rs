@@ -1,6 +1,8 @@
 //! The options of the tasks (shared by `run` and `eval`) and the dispatch to each task.
 
 use clap::Args;
+use polar_dehaze::Method as DehazeMethod;
+use polar_shape::{Integrator, Method};
 
 use crate::tasks::{Context, Failure, Outcome, Task};
 
@@ -17,6 +19,31 @@ pub struct TaskArgs {
     /// allows, else 1.5.
     #[arg(long, value_name = "N", value_parser = parse_ior)]
     pub ior: Option<f64>,
+    /// Shape from polarization, how the azimuth ambiguity is resolved:
+    ///   local   occluding-boundary propagation with a convexity prior (fast)
+    ///   global  height from polarization and shading as one sparse least squares
+    #[arg(verbatim_doc_comment)]
+    #[arg(long, value_name = "NAME", default_value = "local", value_parser = parse_name::<Method>)]
+    pub sfp_method: Method,
+    /// Shape from polarization, depth from normals:
+    ///   poisson  weighted least squares over the objects only (the default)
+    ///   fc       Frankot-Chellappa, least squares in the Fourier domain (whole frame)
+    #[arg(verbatim_doc_comment)]
+    #[arg(long, value_name = "NAME", default_value = "poisson", value_parser = parse_name::<Integrator>)]
+    pub integrator: Integrator,
+    /// Dehazing method:
+    ///   polarization  Schechner-Narasimhan-Nayar: the airlight from its polarization
+    ///   dark-channel  He-Sun-Tang dark channel prior on S0 (the baseline; no polarization)
+    #[arg(verbatim_doc_comment)]
+    #[arg(long, value_name = "NAME", default_value = "polarization", value_parser = parse_name::<DehazeMethod>)]
+    pub dehaze_method: DehazeMethod,
+}
+
+fn parse_name<T: std::str::FromStr>(s: &str) -> Result<T, String>
+where
+    T::Err: std::fmt::Display,
+{
+    s.parse().map_err(|e: T::Err| e.to_string())
 }
 
 fn parse_fov(s: &str) -> Result<f64, String> {
@@ -38,8 +65,11 @@ fn parse_ior(s: &str) -> Result<f64, String> {
 }
 
 /// Runs one task on the context.
-pub fn execute(task: Task, _ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> {
-    Err(Failure::CannotRun(format!(
-        "{task} is not available in this build"
-    )))
+pub fn execute(task: Task, ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
+    match task {
+        Task::Sfp => crate::tasks::sfp::run(ctx, args),
+        Task::Material => crate::tasks::material::run(ctx, args),
+        Task::Dehaze => crate::tasks::dehaze::run(ctx, args),
+        Task::Transparent => crate::tasks::transparent::run(ctx, args),
+    }
 }

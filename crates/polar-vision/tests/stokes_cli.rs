@@ -299,3 +299,65 @@ fn help_lists_every_method_and_the_default_is_residual() {
     let want = stokes_planes(&raw, DemosaicMethod::Residual).unwrap();
     assert_eq!(got, want.linear_stokes());
 }
+
+#[test]
+fn outputs_writes_only_the_files_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("raw.png");
+    polar_io::write_gray8_png(&input, &mosaic8(16, 12)).unwrap();
+    let out = dir.path().join("o");
+    let result = run(&[
+        "stokes",
+        p(&input),
+        "--out",
+        p(&out),
+        "--outputs",
+        "stokes,dolp",
+    ]);
+    assert!(result.status.success(), "{}", stderr(&result));
+    let mut written: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    written.sort();
+    assert_eq!(written, ["dolp.exr", "stokes.exr"]);
+    fails_with(
+        &[
+            "stokes",
+            p(&input),
+            "--out",
+            p(&out),
+            "--outputs",
+            "normals",
+        ],
+        "invalid value",
+    );
+}
+
+#[test]
+fn an_output_folder_inside_the_input_sample_is_refused() {
+    // Regression: `stokes SAMPLE --out SAMPLE` overwrote the sample's stokes.exr.
+    let dir = tempfile::tempdir().unwrap();
+    let sample = dir.path().join("sample");
+    std::fs::create_dir(&sample).unwrap();
+    polar_io::write_gray8_png(sample.join("raw.png"), &mosaic8(8, 8)).unwrap();
+    fails_with(
+        &["stokes", p(&sample), "--out", p(&sample)],
+        "would be overwritten",
+    );
+    let inner = sample.join("out");
+    fails_with(&["stokes", p(&sample), "--out", p(&inner)], "inside");
+    assert!(!inner.exists(), "nothing is created before the refusal");
+    let raw = sample.join("raw.png");
+    fails_with(
+        &["stokes", p(&raw), "--out", p(&sample)],
+        "would be overwritten",
+    );
+    fails_with(
+        &["run", p(&sample), "--out", p(&sample)],
+        "would be overwritten",
+    );
+    let beside = dir.path().join("beside");
+    let ok = run(&["stokes", p(&raw), "--out", p(&beside)]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+}

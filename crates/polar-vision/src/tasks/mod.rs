@@ -1,8 +1,13 @@
 //! The analysis tasks as `run` and `eval` see them: a closed set, run in dependency order
 //! over one [`Context`], each writing its outputs and, with ground truth, its metrics.
 
+pub mod dehaze;
+pub mod material;
+pub mod sfp;
+pub mod transparent;
+
 use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
 use polar_image::{Gray, Image};
@@ -55,6 +60,8 @@ pub struct Context<'a> {
     pub gt: &'a GroundTruth,
     /// Where outputs go.
     pub out: &'a Path,
+    /// Ground-truth radiance per unit of the observation's S0, where known (see `run`).
+    pub radiance_per_unit: Option<f64>,
     /// Normals from `sfp`, for `material`.
     pub normals: Option<Image<f32, 3>>,
     /// Transparency mask from `transparent`, for `material`.
@@ -102,6 +109,16 @@ pub fn object_mask(gt: &GroundTruth) -> Option<Gray<u8>> {
         .iter_mut()
         .for_each(|v| *v = u8::from(*v != 0));
     Some(out)
+}
+
+/// A write failure of an output.
+pub fn io(e: polar_io::Error) -> Failure {
+    Failure::Cli(e.into())
+}
+
+/// `OUT/pictures/NAME`.
+pub fn picture_path(out: &Path, name: &str) -> PathBuf {
+    out.join(polar_io::files::vision::PICTURES).join(name)
 }
 
 /// Serializes task metrics for `metrics.json`.

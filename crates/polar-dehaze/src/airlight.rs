@@ -1,0 +1,508 @@
+//! Automatic estimation of the airlight's polarization: its angle field `alpha(x, y)`, its
+//! degree `p` and its brightness at infinity `A_inf`, from the observation alone.
+//!
+//! Estimator (all on block means of S0, S1, S2 over a grid of at most [`GRID`] blocks a
+//! side, which averages noise and bounds the cost):
+//!
+//! 1. **Angle field.** The airlight's AoLP is not one angle over the frame (single
+//!    scattering polarizes perpendicular to the sun-view plane, which turns across the
+//!    field of view). We fit a polynomial of degree [`MAX_DEGREE`] in the normalised
+//!    image coordinates to the unit vectors `(cos 2a, sin 2a)` of the blocks, weighted by
+//!    their polarized intensity `sqrt(S1^2 + S2^2)` (so the airlight-dominated, distant
+//!    blocks lead), by iteratively reweighted least squares with Tukey's biweight on the
+//!    angular residual (blocks whose own polarization, e.g. specular reflection, points
+//!    elsewhere drop out). `alpha` is the angle of the fitted vector.
+//! 2. **Degree `p`.** With unpolarized direct light the projected polarization
+//!    `P = S1 cos 2alpha + S2 sin 2alpha` equals `p A <= p S0`, with equality where no
+//!    direct light arrives (sky, or a black object). So `p` is the upper envelope of
+//!    `P / S0`: its [`ENVELOPE_QUANTILE`] quantile over blocks brighter than
+//!    [`DARK_LEVEL`] (dark blocks are dominated by noise).
+//! 3. **`p` over the frame** (`varying_airlight`, [`SkyField`]). The sky's degree of
+//!    polarization is not one number either (it follows the scattering angle). Blocks
+//!    with `P / S0 >= SKY_LEVEL p` and `P / p >= SKY_LEVEL A_inf` are sky candidates; an
+//!    upper-envelope plane of their `P / S0` picks those at infinity, and a plane fitted
+//!    to them (clamped to their range) gives `p(x, y)`. Needs [`MIN_SKY_BLOCKS`] of them.
+//! 4. **`A_inf`.** The airlight `A = P / p` grows with distance towards `A_inf`; we take
+//!    its [`AIRLIGHT_QUANTILE`] quantile over the blocks. Where sky is visible that is the
+//!    sky's S0 (Schechner et al. measure `A_inf` and `p` on the sky).
+//!
+//! Failure modes (reported as warnings where they can be detected):
+//! - no sky and no black object in view: `P / S0 < p` everywhere, so `p` is underestimated
+//!   and `A = P / p` overestimated: `t` comes out too low (over-dehazed, radiance too dark);
+//! - no sky: the largest airlight is that of the most distant object, below `A_inf`, so
+//!   `t` of that region tends to 0 (clamped at `t_min`);
+//! - strongly polarized objects (specular reflections, glass, water) aligned with the
+//!   airlight raise the envelope (`p` too high: under-dehazed) and look like airlight;
+//! - haze thickening smoothly up to the horizon (a ground plane to infinity): hazy ground
+//!   just below the horizon passes as sky and tilts the plane of `p` (`p` too low far
+//!   from the horizon, so `t` too low there); `varying_airlight: false` avoids it;
+//! - `A_inf` is taken as one number: a sky much brighter on one side (towards the sun)
+//!   leaves `t > 0` on the darker side;
+//! - airlight polarization at the noise level: `p` is then noise; [`crate::polarization`]
+//!   falls back when `p < min_airlight_dolp`.
+
+use polar_image::Gray;
+use rayon::prelude::*;
+
+use crate::prep::Normalized;
+
+/// Largest number of blocks along the longer image side.
+pub const GRID: usize = 32;
+/// Degree of the polynomial angle field (6 coefficients per component).
+pub const MAX_DEGREE: usize = 2;
+/// Blocks darker than this fraction of `s0_scale` are left out of the `p` envelope.
+pub const DARK_LEVEL: f32 = 0.02;
+/// Quantile of `P / S0` taken as the airlight's degree of polarization `p`.
+pub const ENVELOPE_QUANTILE: f64 = 0.99;
+/// Quantile of `P / p` taken as `A_inf`.
+pub const AIRLIGHT_QUANTILE: f64 = 0.995;
+/// Tukey biweight cut-off of the angle field's residual, in doubled-angle radians (45 deg
+/// in 2a, i.e. 22.5 deg of AoLP).
+const TUKEY_C: f64 = std::f64::consts::FRAC_PI_4;
+/// Reweighting passes of the angle-field fit.
+const IRLS_PASSES: usize = 5;
+
+/// The airlight's polarization and brightness, in the units of the normalised S0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AirlightEstimate {
+    /// Airlight at infinity `A_inf` (normalised by `s0_scale`).
+    pub a_inf: f32,
+    /// Degree of polarization `p` of the airlight (at the image centre when it varies).
+    pub p: f32,
+    /// The angle field (`cos 2alpha`, `sin 2alpha` polynomials).
+    pub field: AngleField,
+    /// `p` varying over the frame, where enough sky is seen.
+    pub sky: Option<SkyField>,
+    /// Fraction of the blocks that look like sky (`P / S0 >= 0.8 p` and `A >= 0.8 A_inf`).
+    pub sky_fraction: f32,
+    /// Number of blocks used.
+    pub blocks: usize,
+}
+
+/// A smooth field of polarization directions: `(c, s)(x, y) = sum_k coef_k x^i y^j` over
+/// the monomials of degree `<= degree` in normalised coordinates `x, y in [-1, 1]`;
+/// the direction is `(c, s) / |(c, s)|`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AngleField {
+    /// Polynomial degree.
+    pub degree: usize,
+    /// Coefficients of `cos 2alpha`.
+    pub cos: Vec<f64>,
+    /// Coefficients of `sin 2alpha`.
+    pub sin: Vec<f64>,
+}
+
+impl AngleField {
+    /// A constant direction `alpha`.
+    pub fn constant(alpha: f64) -> Self {
+        Self {
+            degree: 0,
+            cos: vec![(2.0 * alpha).cos()],
+            sin: vec![(2.0 * alpha).sin()],
+        }
+    }
+
+    /// Unit `(cos 2alpha, sin 2alpha)` at normalised `(x, y)`; `(1, 0)` where the field
+    /// vanishes.
+    pub fn direction(&self, x: f64, y: f64) -> (f64, f64) {
+        let (phi, n) = monomials_array(self.degree, x, y);
+        let c: f64 = phi[..n].iter().zip(&self.cos).map(|(p, a)| p * a).sum();
+        let s: f64 = phi[..n].iter().zip(&self.sin).map(|(p, a)| p * a).sum();
+        let n = c.hypot(s);
+        if n > 0.0 && n.is_finite() {
+            (c / n, s / n)
+        } else {
+            (1.0, 0.0)
+        }
+    }
+
+    /// The airlight's AoLP `alpha` in `[0, pi)` at normalised `(x, y)`.
+    pub fn aolp(&self, x: f64, y: f64) -> f64 {
+        let (c, s) = self.direction(x, y);
+        (0.5 * s.atan2(c)).rem_euclid(std::f64::consts::PI)
+    }
+
+    /// Projected polarization `P = S1 cos 2alpha + S2 sin 2alpha` per pixel.
+    pub fn project(&self, s1: &Gray<f32>, s2: &Gray<f32>) -> Gray<f32> {
+        let (w, h) = s1.size();
+        let mut out = Gray::new(w, h);
+        out.as_mut_slice()
+            .par_chunks_mut(w.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                let yn = norm_coord(y, h);
+                for (x, o) in row.iter_mut().enumerate() {
+                    let (c, s) = self.direction(norm_coord(x, w), yn);
+                    let k = y * w + x;
+                    *o = (f64::from(s1.as_slice()[k]) * c + f64::from(s2.as_slice()[k]) * s) as f32;
+                }
+            });
+        out
+    }
+}
+
+/// Pixel centre `i` of `n` mapped to `[-1, 1]`.
+pub fn norm_coord(i: usize, n: usize) -> f64 {
+    (2.0 * i as f64 + 1.0) / n as f64 - 1.0
+}
+
+/// The monomials `x^i y^j`, `i + j <= degree` (at most [`MAX_DEGREE`]), in a fixed order.
+fn monomials(degree: usize, x: f64, y: f64) -> Vec<f64> {
+    let (m, n) = monomials_array(degree, x, y);
+    m[..n].to_vec()
+}
+
+/// [`monomials`] without allocation: the values and how many there are.
+fn monomials_array(degree: usize, x: f64, y: f64) -> ([f64; 6], usize) {
+    let all = [1.0, x, y, x * x, x * y, y * y];
+    let n = match degree {
+        0 => 1,
+        1 => 3,
+        _ => 6,
+    };
+    (all, n)
+}
+
+/// Block means of the valid pixels.
+#[derive(Clone, Debug)]
+pub struct Blocks {
+    /// Mean normalised S0 per usable block.
+    pub s0: Vec<f32>,
+    /// Mean normalised S1.
+    pub s1: Vec<f32>,
+    /// Mean normalised S2.
+    pub s2: Vec<f32>,
+    /// Normalised x of the block's centre.
+    pub x: Vec<f64>,
+    /// Normalised y of the block's centre.
+    pub y: Vec<f64>,
+}
+
+impl Blocks {
+    /// Means over `b x b` blocks, `b = ceil(max(w, h) / GRID)`, keeping the blocks whose
+    /// pixels are at least half valid and whose mean S0 is positive.
+    pub fn new(input: &Normalized) -> Self {
+        let (w, h) = input.s0.size();
+        let b = w.max(h).div_ceil(GRID).max(1);
+        let (gw, gh) = (w.div_ceil(b), h.div_ceil(b));
+        let mut acc = vec![[0.0f64; 4]; gw * gh];
+        let (s0, s1, s2) = (
+            input.s0.as_slice(),
+            input.s1.as_slice(),
+            input.s2.as_slice(),
+        );
+        for y in 0..h {
+            for x in 0..w {
+                let k = y * w + x;
+                if input.valid[k] {
+                    let a = &mut acc[(y / b) * gw + x / b];
+                    a[0] += f64::from(s0[k]);
+                    a[1] += f64::from(s1[k]);
+                    a[2] += f64::from(s2[k]);
+                    a[3] += 1.0;
+                }
+            }
+        }
+        let mut out = Self {
+            s0: vec![],
+            s1: vec![],
+            s2: vec![],
+            x: vec![],
+            y: vec![],
+        };
+        for (g, a) in acc.iter().enumerate() {
+            let (bx, by) = (g % gw, g / gw);
+            let (x0, y0) = (bx * b, by * b);
+            let (bw, bh) = ((x0 + b).min(w) - x0, (y0 + b).min(h) - y0);
+            if a[3] < 0.5 * (bw * bh) as f64 || a[0] <= 0.0 {
+                continue;
+            }
+            out.s0.push((a[0] / a[3]) as f32);
+            out.s1.push((a[1] / a[3]) as f32);
+            out.s2.push((a[2] / a[3]) as f32);
+            out.x.push((2.0 * x0 as f64 + bw as f64) / w as f64 - 1.0);
+            out.y.push((2.0 * y0 as f64 + bh as f64) / h as f64 - 1.0);
+        }
+        out
+    }
+
+    /// Number of usable blocks.
+    pub fn len(&self) -> usize {
+        self.s0.len()
+    }
+
+    /// `true` without usable blocks.
+    pub fn is_empty(&self) -> bool {
+        self.s0.is_empty()
+    }
+}
+
+/// Fits the airlight's angle field to the blocks (IRLS, see the module doc). The degree
+/// drops to 1 or 0 when there are too few blocks for a stable fit (fewer than four per
+/// coefficient). `None` when no block is polarized at all.
+pub fn fit_angle_field(blocks: &Blocks) -> Option<AngleField> {
+    let n = blocks.len();
+    let degree = (0..=MAX_DEGREE)
+        .rev()
+        .find(|&d| n >= 4 * (d + 1) * (d + 2) / 2)
+        .unwrap_or(0);
+    let mag: Vec<f64> = (0..n)
+        .map(|i| f64::from(blocks.s1[i]).hypot(f64::from(blocks.s2[i])))
+        .collect();
+    if !mag.iter().any(|&m| m > 0.0) {
+        return None;
+    }
+    let unit: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
+            if mag[i] > 0.0 {
+                (
+                    f64::from(blocks.s1[i]) / mag[i],
+                    f64::from(blocks.s2[i]) / mag[i],
+                )
+            } else {
+                (0.0, 0.0)
+            }
+        })
+        .collect();
+    let phi: Vec<Vec<f64>> = (0..n)
+        .map(|i| monomials(degree, blocks.x[i], blocks.y[i]))
+        .collect();
+    let mut weights = mag.clone();
+    let mut field = weighted_fit(degree, &phi, &unit, &weights)?;
+    for _ in 0..IRLS_PASSES {
+        let mut any = false;
+        for i in 0..n {
+            let (c, s) = field.direction(blocks.x[i], blocks.y[i]);
+            let cos_r = (unit[i].0 * c + unit[i].1 * s).clamp(-1.0, 1.0);
+            let r = cos_r.acos() / TUKEY_C;
+            weights[i] = if r < 1.0 {
+                mag[i] * (1.0 - r * r).powi(2)
+            } else {
+                0.0
+            };
+            any |= weights[i] > 0.0;
+        }
+        if !any {
+            break;
+        }
+        match weighted_fit(degree, &phi, &unit, &weights) {
+            Some(f) => field = f,
+            None => break,
+        }
+    }
+    Some(field)
+}
+
+/// Weighted least squares of both components on the monomials, with a tiny ridge so
+/// that a degenerate layout (one row of blocks) still solves.
+fn weighted_fit(
+    degree: usize,
+    phi: &[Vec<f64>],
+    unit: &[(f64, f64)],
+    weights: &[f64],
+) -> Option<AngleField> {
+    let m = (degree + 1) * (degree + 2) / 2;
+    let mut ata = vec![vec![0.0; m]; m];
+    let (mut bc, mut bs) = (vec![0.0; m], vec![0.0; m]);
+    let mut wsum = 0.0;
+    for ((p, u), &w) in phi.iter().zip(unit).zip(weights) {
+        if w <= 0.0 {
+            continue;
+        }
+        wsum += w;
+        for a in 0..m {
+            for b in 0..m {
+                ata[a][b] += w * p[a] * p[b];
+            }
+            bc[a] += w * p[a] * u.0;
+            bs[a] += w * p[a] * u.1;
+        }
+    }
+    if wsum <= 0.0 {
+        return None;
+    }
+    for (a, row) in ata.iter_mut().enumerate() {
+        row[a] += 1e-9 * wsum;
+    }
+    Some(AngleField {
+        degree,
+        cos: solve(ata.clone(), bc)?,
+        sin: solve(ata, bs)?,
+    })
+}
+
+/// Solves `a x = b` by Gaussian elimination with partial pivoting; `None` if singular.
+fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let m = b.len();
+    for col in 0..m {
+        let piv = (col..m).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[piv][col].abs() < 1e-300 || !a[piv][col].is_finite() {
+            return None;
+        }
+        a.swap(col, piv);
+        b.swap(col, piv);
+        let (top, rest) = a.split_at_mut(col + 1);
+        let pivot_row = &top[col];
+        for (r, row) in rest.iter_mut().enumerate() {
+            let f = row[col] / pivot_row[col];
+            row[col..]
+                .iter_mut()
+                .zip(&pivot_row[col..])
+                .for_each(|(v, p)| *v -= f * p);
+            b[col + 1 + r] -= f * b[col];
+        }
+    }
+    let mut x = vec![0.0; m];
+    for r in (0..m).rev() {
+        let s: f64 = (r + 1..m).map(|c| a[r][c] * x[c]).sum();
+        x[r] = (b[r] - s) / a[r][r];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// The `q`-quantile (nearest rank) of `v`; `None` if empty.
+pub fn quantile(v: &[f32], q: f64) -> Option<f32> {
+    let mut v: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+    Some(*v.select_nth_unstable_by(k, f32::total_cmp).1)
+}
+
+/// Estimates `alpha(x, y)`, `p` and `A_inf` (see the module doc). `None` when no usable
+/// block is polarized.
+pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
+    let blocks = Blocks::new(input);
+    let field = fit_angle_field(&blocks)?;
+    let n = blocks.len();
+    let proj: Vec<f32> = (0..n)
+        .map(|i| {
+            let (c, s) = field.direction(blocks.x[i], blocks.y[i]);
+            (f64::from(blocks.s1[i]) * c + f64::from(blocks.s2[i]) * s) as f32
+        })
+        .collect();
+    let ratio: Vec<f32> = (0..n)
+        .filter(|&i| blocks.s0[i] >= DARK_LEVEL)
+        .map(|i| proj[i] / blocks.s0[i])
+        .collect();
+    let p = quantile(&ratio, ENVELOPE_QUANTILE)?.clamp(0.0, 1.0);
+    let airlight: Vec<f32> = proj.iter().map(|&v| v / p).collect();
+    let a_inf = if p > 0.0 {
+        quantile(&airlight, AIRLIGHT_QUANTILE)?
+    } else {
+        0.0
+    };
+    let sky: Vec<usize> = (0..n)
+        .filter(|&i| {
+            p > 0.0
+                && blocks.s0[i] >= DARK_LEVEL
+                && proj[i] >= SKY_LEVEL * p * blocks.s0[i]
+                && airlight[i] >= SKY_LEVEL * a_inf
+        })
+        .collect();
+    let sky_field = (varying && sky.len() >= MIN_SKY_BLOCKS)
+        .then(|| SkyField::fit(&blocks, &proj, &sky))
+        .flatten()
+        .filter(|f| f.dolp_range.0 > 0.0);
+    let (p, a_inf) = match &sky_field {
+        Some(f) => {
+            let a: Vec<f32> = (0..n)
+                .map(|i| (f64::from(proj[i]) / f.at(blocks.x[i], blocks.y[i])) as f32)
+                .collect();
+            (f.at(0.0, 0.0) as f32, quantile(&a, AIRLIGHT_QUANTILE)?)
+        }
+        None => (p, a_inf),
+    };
+    Some(AirlightEstimate {
+        a_inf,
+        p,
+        field,
+        sky: sky_field,
+        sky_fraction: sky.len() as f32 / n.max(1) as f32,
+        blocks: n,
+    })
+}
+
+/// Blocks whose airlight fraction `P / (p S0)` and airlight `P / p` both reach this
+/// fraction of their maxima count as sky (or as distant enough to stand for it).
+pub const SKY_LEVEL: f32 = 0.5;
+/// Fewest sky blocks for the [`SkyField`] planes (three coefficients each).
+pub const MIN_SKY_BLOCKS: usize = 12;
+/// Expectile of the upper-envelope plane of `P` over the sky candidates.
+pub const ENVELOPE_EXPECTILE: f64 = 0.99;
+/// Reweighting passes of the expectile fit.
+const EXPECTILE_PASSES: usize = 10;
+/// Candidates whose `P` is within this fraction below the envelope are at infinity.
+pub const INFINITY_TOLERANCE: f64 = 0.1;
+
+/// The airlight's degree of polarization as it varies over the frame: a plane
+/// `p(x, y) = a + b x + c y` in normalised image coordinates fitted to the blocks at
+/// infinity (sky), where `P / S0 = p` exactly, evaluated clamped to the range of their
+/// values so that the extrapolation stays within what was seen. Single scattering makes
+/// `p` depend on the angle to the sun, which turns across a wide field of view.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkyField {
+    /// Plane coefficients `[a, b, c]` of `p`.
+    pub dolp: [f64; 3],
+    /// Range of the sky blocks' `P / S0`.
+    pub dolp_range: (f64, f64),
+    /// Number of blocks taken as infinity.
+    pub blocks: usize,
+}
+
+impl SkyField {
+    /// Fits the plane. `P / S0 <= p` everywhere, with equality only where no direct light
+    /// arrives, so the candidates (which include hazy but finite distances) first get an
+    /// upper-envelope plane of `P / S0` (expectile regression, [`ENVELOPE_EXPECTILE`]); the
+    /// blocks within [`INFINITY_TOLERANCE`] of it are taken as infinity and the plane is
+    /// refitted to them by least squares.
+    fn fit(blocks: &Blocks, proj: &[f32], candidates: &[usize]) -> Option<Self> {
+        let plane_of = |idx: &[usize], v: &dyn Fn(usize) -> f64, wts: &[f64]| {
+            let phi: Vec<Vec<f64>> = idx
+                .iter()
+                .map(|&i| monomials(1, blocks.x[i], blocks.y[i]))
+                .collect();
+            let vals: Vec<(f64, f64)> = idx.iter().map(|&i| (v(i), 0.0)).collect();
+            weighted_fit(1, &phi, &vals, wts).map(|f| [f.cos[0], f.cos[1], f.cos[2]])
+        };
+        let eval = |c: &[f64; 3], i: usize| c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i];
+        let dolp = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
+        let mut wts = vec![1.0; candidates.len()];
+        let mut env = plane_of(candidates, &dolp, &wts)?;
+        for _ in 0..EXPECTILE_PASSES {
+            for (w, &i) in wts.iter_mut().zip(candidates) {
+                *w = if dolp(i) >= eval(&env, i) {
+                    ENVELOPE_EXPECTILE
+                } else {
+                    1.0 - ENVELOPE_EXPECTILE
+                };
+            }
+            env = plane_of(candidates, &dolp, &wts)?;
+        }
+        let inf: Vec<usize> = candidates
+            .iter()
+            .copied()
+            .filter(|&i| dolp(i) >= (1.0 - INFINITY_TOLERANCE) * eval(&env, i))
+            .collect();
+        if inf.len() < MIN_SKY_BLOCKS {
+            return None;
+        }
+        let range = inf
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
+                (lo.min(dolp(i)), hi.max(dolp(i)))
+            });
+        Some(Self {
+            dolp: plane_of(&inf, &dolp, &vec![1.0; inf.len()])?,
+            dolp_range: range,
+            blocks: inf.len(),
+        })
+    }
+
+    /// `p` at normalised `(x, y)`.
+    pub fn at(&self, x: f64, y: f64) -> f64 {
+        let c = &self.dolp;
+        (c[0] + c[1] * x + c[2] * y).clamp(self.dolp_range.0, self.dolp_range.1)
+    }
+}

@@ -1,0 +1,286 @@
+//! Dehazing of one polarization observation.
+//!
+//! The haze model (Koschmieder; Schechner, Narasimhan, Nayar 2001/2003) is
+//! `S0 = L t + A`, `A = A_inf (1 - t)`: the object radiance `L` attenuated by the
+//! transmission `t = exp(-beta z)` plus the airlight `A` scattered into the ray, which
+//! tends to `A_inf` (the horizon's brightness) for distant objects. Two ways to find `t`:
+//!
+//! - [`Method::Polarization`] ([`polarization`]): the airlight is partially polarized
+//!   (degree `p`, angle `alpha`) while the direct light is taken as unpolarized, so the
+//!   projection of `(S1, S2)` on the airlight's polarization direction is `p A`:
+//!   `A = (S1 cos 2alpha + S2 sin 2alpha) / p`, `t = 1 - A / A_inf`.
+//!   Schechner, Narasimhan, Nayar, "Instant dehazing of images using polarization",
+//!   CVPR 2001; "Polarization-based vision through haze", Applied Optics 2003.
+//! - [`Method::DarkChannel`] ([`dark_channel`]): He, Sun, Tang's dark channel prior
+//!   (CVPR 2009 / TPAMI 2011) on S0 alone, the baseline.
+//!
+//! Both refine `t` with a guided filter (guide S0; He, Sun, Tang, ECCV 2010), bound it
+//! to `[t_min, 1]` and invert the model, `L = (S0 - A_inf) / t + A_inf`.
+//!
+//! All intensities are divided by [`Observation::s0_scale`] first, so the transmission
+//! does not depend on the exposure and the radiance scales with it. Saturated and
+//! zero pixels ([`Observation::is_valid`]) take no part in any estimate; their
+//! transmission is filled in from valid neighbours (see [`refine`]).
+
+pub mod airlight;
+pub mod dark_channel;
+pub mod polarization;
+pub mod prep;
+pub mod refine;
+
+use std::fmt;
+use std::str::FromStr;
+
+use polar_image::Gray;
+use polar_sensor::Observation;
+use thiserror::Error;
+
+pub use airlight::AirlightEstimate;
+
+/// Errors of dehazing.
+#[derive(Debug, Error, PartialEq)]
+pub enum DehazeError {
+    /// A method name that is not known.
+    #[error("unknown dehazing method `{0}` (known: polarization, dark-channel)")]
+    UnknownMethod(String),
+    /// An option is out of its valid range.
+    #[error("invalid option `{name}` = {value}: {reason}")]
+    Option {
+        /// Option name.
+        name: &'static str,
+        /// Value given.
+        value: f64,
+        /// Valid range.
+        reason: &'static str,
+    },
+    /// The observation has no pixels.
+    #[error("empty observation ({0}x{1})")]
+    Empty(usize, usize),
+    /// An image-processing primitive failed (sizes are checked before, so this is a bug).
+    #[error("image processing: {0}")]
+    Imgproc(#[from] polar_imgproc::Error),
+}
+
+/// How the transmission is estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Schechner-Narasimhan-Nayar polarization dehazing (needs polarized airlight).
+    #[default]
+    Polarization,
+    /// He-Sun-Tang dark channel prior on S0 (ignores polarization), the baseline.
+    DarkChannel,
+}
+
+impl Method {
+    /// The names accepted by [`FromStr`], in the order of the variants.
+    pub const NAMES: [&'static str; 2] = ["polarization", "dark-channel"];
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Method::Polarization => Self::NAMES[0],
+            Method::DarkChannel => Self::NAMES[1],
+        })
+    }
+}
+
+impl FromStr for Method {
+    type Err = DehazeError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "polarization" => Ok(Method::Polarization),
+            "dark-channel" => Ok(Method::DarkChannel),
+            other => Err(DehazeError::UnknownMethod(other.to_string())),
+        }
+    }
+}
+
+/// What [`Method::Polarization`] does when the airlight is not (detectably) polarized.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum WeakPolarization {
+    /// Use the dark-channel transmission instead (a warning says so).
+    #[default]
+    DarkChannel,
+    /// Return the input unchanged, `t = 1` (a warning says so).
+    Identity,
+}
+
+/// Options of [`dehaze`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DehazeOptions {
+    /// Transmission estimator.
+    pub method: Method,
+    /// Lower bound of the transmission (He et al.'s `t0`): bounds the amplification
+    /// `1 / t` of noise in the radiance. In `(0, 1]`.
+    pub t_min: f32,
+    /// Radius of the guided filter that refines `t` (window `2 r + 1`); 0 disables it.
+    pub guided_radius: usize,
+    /// Guided-filter regularisation in squared units of the normalised S0 (`S0 / s0_scale`):
+    /// larger smooths `t` more across weak edges of S0.
+    pub guided_eps: f32,
+    /// Dark channel patch size (odd), He et al.'s 15.
+    pub dcp_patch: usize,
+    /// Dark channel haze-keeping factor `omega`, He et al.'s 0.95.
+    pub dcp_omega: f32,
+    /// Below this estimated airlight degree of polarization `p` the polarization method
+    /// gives up (the airlight cannot be told from noise) and applies [`Self::weak_fallback`].
+    pub min_airlight_dolp: f32,
+    /// What the polarization method does when `p < min_airlight_dolp`.
+    pub weak_fallback: WeakPolarization,
+    /// Let `p` and `A_inf` vary over the frame (planes fitted to the sky,
+    /// [`airlight::SkyField`]) where enough sky is seen; `false` keeps Schechner et al.'s
+    /// single `p` and `A_inf`.
+    pub varying_airlight: bool,
+    /// Radius of the edge-preserving denoising of S0 before the inversion (a self-guided
+    /// filter with `eps` = 9 noise variances, [`refine::denoise`]); 0 inverts S0 as measured.
+    /// The inversion multiplies noise by `1 / t`; on a noiseless image this is the identity.
+    pub denoise_radius: usize,
+}
+
+impl Default for DehazeOptions {
+    /// Polarization, `t_min = 0.1`, guided filter `r = 15`, `eps = 1e-3`, dark channel
+    /// patch 15 and `omega = 0.95` (He et al.), `min_airlight_dolp = 0.02`, dark-channel
+    /// fallback, varying airlight, denoising radius 2.
+    fn default() -> Self {
+        Self {
+            method: Method::Polarization,
+            t_min: 0.1,
+            guided_radius: 15,
+            guided_eps: 1e-3,
+            dcp_patch: 15,
+            dcp_omega: 0.95,
+            min_airlight_dolp: 0.02,
+            weak_fallback: WeakPolarization::DarkChannel,
+            varying_airlight: true,
+            denoise_radius: 2,
+        }
+    }
+}
+
+impl DehazeOptions {
+    /// Checks the ranges of the options.
+    pub fn validate(&self) -> Result<(), DehazeError> {
+        let bad = |name, value: f64, reason| {
+            Err(DehazeError::Option {
+                name,
+                value,
+                reason,
+            })
+        };
+        if !(self.t_min > 0.0 && self.t_min <= 1.0) {
+            return bad("t_min", self.t_min.into(), "must be in (0, 1]");
+        }
+        if !(self.guided_eps >= 0.0 && self.guided_eps.is_finite()) {
+            return bad(
+                "guided_eps",
+                self.guided_eps.into(),
+                "must be finite and >= 0",
+            );
+        }
+        if self.dcp_patch == 0 || self.dcp_patch.is_multiple_of(2) {
+            return bad("dcp_patch", self.dcp_patch as f64, "must be odd and >= 1");
+        }
+        if !(self.dcp_omega >= 0.0 && self.dcp_omega <= 1.0) {
+            return bad("dcp_omega", self.dcp_omega.into(), "must be in [0, 1]");
+        }
+        if !(self.min_airlight_dolp >= 0.0 && self.min_airlight_dolp <= 1.0) {
+            return bad(
+                "min_airlight_dolp",
+                self.min_airlight_dolp.into(),
+                "must be in [0, 1]",
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The result of [`dehaze`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dehazed {
+    /// Dehazed radiance `L = (S0 - A_inf) / t + A_inf`, clamped to `>= 0`, in the unit of S0.
+    pub radiance: Gray<f32>,
+    /// Transmission `t` in `[t_min, 1]`.
+    pub transmission: Gray<f32>,
+    /// Relative depth `-ln t` (optical depth, `beta z`), in `[0, -ln t_min]`.
+    pub depth: Gray<f32>,
+    /// Airlight at infinity `A_inf`, in the unit of S0.
+    pub airlight_inf: f32,
+    /// Degree of polarization `p` of the airlight, at the image centre where it varies
+    /// (0 for the dark channel method; the estimate that was too weak after a fallback).
+    pub airlight_dolp: f32,
+    /// The estimator that produced `t` (differs from the requested one after a fallback).
+    pub method: Method,
+    /// What went wrong or was assumed (fallbacks, excluded pixels, missing sky).
+    pub warnings: Vec<String>,
+}
+
+/// Dehazes `obs` with `opts.method`: transmission, relative depth and radiance.
+///
+/// Never fails on the content of the image (NaN, all-zero, saturated, 1x1): those give a
+/// finite result and a warning; it fails only on invalid options or an empty image.
+pub fn dehaze(obs: &Observation, opts: &DehazeOptions) -> Result<Dehazed, DehazeError> {
+    opts.validate()?;
+    let (w, h) = obs.size();
+    if w == 0 || h == 0 {
+        return Err(DehazeError::Empty(w, h));
+    }
+    let input = prep::Normalized::new(obs);
+    let mut warnings = input.warnings();
+    let estimate = match opts.method {
+        Method::DarkChannel => dark_channel::transmission(&input, opts)?,
+        Method::Polarization => polarization::transmission(&input, opts)?,
+    };
+    warnings.extend(estimate.warnings.iter().cloned());
+    let t = refine::refine(&input, &estimate.raw_t, opts, estimate.guided_eps)?;
+    let s0 = refine::denoise(&input, &t, opts.denoise_radius)?;
+    Ok(finish(&input, &s0, t, &estimate, warnings))
+}
+
+/// A raw (unrefined) transmission and the airlight it assumes, in normalised units.
+#[derive(Clone, Debug)]
+pub struct RawEstimate {
+    /// Per-pixel transmission before refinement (any finite value; NaN where unknown).
+    pub raw_t: Gray<f32>,
+    /// Airlight at infinity, normalised (`A_inf / s0_scale`).
+    pub airlight_inf: f32,
+    /// Degree of polarization of the airlight.
+    pub airlight_dolp: f32,
+    /// The method that produced `raw_t`.
+    pub method: Method,
+    /// The guided filter's regularisation for this estimate.
+    pub guided_eps: f32,
+    /// Warnings of the estimator.
+    pub warnings: Vec<String>,
+}
+
+/// Radiance `(S0 - A_inf) / t + A_inf` (clamped to `>= 0`) and depth `-ln t`, back in
+/// the unit of S0.
+fn finish(
+    input: &prep::Normalized,
+    s0: &Gray<f32>,
+    t: Gray<f32>,
+    est: &RawEstimate,
+    warnings: Vec<String>,
+) -> Dehazed {
+    let (w, h) = input.s0.size();
+    let a = est.airlight_inf;
+    let scale = input.scale;
+    let radiance: Vec<f32> = s0
+        .as_slice()
+        .iter()
+        .zip(t.as_slice())
+        .map(|(&i, &t)| (((i - a) / t + a).max(0.0)) * scale)
+        .collect();
+    let depth: Vec<f32> = t.as_slice().iter().map(|&t| (-t.ln()).max(0.0)).collect();
+    Dehazed {
+        radiance: Gray::from_vec(w, h, radiance).expect("size matches"),
+        depth: Gray::from_vec(w, h, depth).expect("size matches"),
+        transmission: t,
+        airlight_inf: a * scale,
+        airlight_dolp: est.airlight_dolp,
+        method: est.method,
+        warnings,
+    }
+}

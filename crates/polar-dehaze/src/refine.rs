@@ -1,0 +1,163 @@
+//! Refinement of a raw transmission: fill the pixels where it is unknown, guided filter
+//! (guide: normalised S0, as He et al. refine the dark channel), bound to `[t_min, 1]`.
+
+use polar_image::Gray;
+use polar_imgproc::{Border, box_filter, guided_filter};
+
+use crate::prep::Normalized;
+use crate::{DehazeError, DehazeOptions};
+
+/// Fills the NaN entries of `raw` (unknown: invalid pixels), runs the guided filter of
+/// radius `opts.guided_radius` (skipped for 0) and regularisation `eps`, and clamps to
+/// `[t_min, 1]`. Every output value is finite.
+pub fn refine(
+    input: &Normalized,
+    raw: &Gray<f32>,
+    opts: &DehazeOptions,
+    eps: f32,
+) -> Result<Gray<f32>, DehazeError> {
+    let filled = fill_unknown(raw, opts.guided_radius.max(1))?;
+    let mut t = Gray::new(raw.width(), raw.height());
+    if opts.guided_radius > 0 {
+        guided_filter(
+            &input.s0,
+            &filled,
+            &mut t,
+            safe_radius(opts.guided_radius, raw.width()),
+            f64::from(eps),
+        )?;
+    } else {
+        t = filled;
+    }
+    let t_min = opts.t_min;
+    t.as_mut_slice().iter_mut().for_each(|v| {
+        *v = if v.is_finite() {
+            v.clamp(t_min, 1.0)
+        } else {
+            1.0
+        }
+    });
+    Ok(t)
+}
+
+/// `radius`, reduced to 4 on images narrower than 16 pixels: `polar_imgproc::box_filter`
+/// indexes out of bounds for windows wider than 9 on some widths below 10 (1, 2, 3, 5, 6,
+/// 9), and on such images a 9-wide window already spans most of the row.
+fn safe_radius(radius: usize, width: usize) -> usize {
+    if width < 16 { radius.min(4) } else { radius }
+}
+
+/// Replaces NaN values by the mean of the known values in the `(2 radius + 1)^2` window
+/// (normalised convolution), widening the window until some are known; all unknown gives 1.
+pub fn fill_unknown(raw: &Gray<f32>, radius: usize) -> Result<Gray<f32>, DehazeError> {
+    let (w, h) = raw.size();
+    let known: Vec<bool> = raw.as_slice().iter().map(|v| v.is_finite()).collect();
+    if known.iter().all(|&k| k) {
+        return Ok(raw.clone());
+    }
+    if !known.iter().any(|&k| k) {
+        return Ok(Gray::from_vec(w, h, vec![1.0; w * h]).expect("size matches"));
+    }
+    let mut out = raw.clone();
+    let mut r = radius;
+    loop {
+        let (num, den) = window_sums(raw, &known, r)?;
+        let mut missing = false;
+        for (k, o) in out.as_mut_slice().iter_mut().enumerate() {
+            if !known[k] && !o.is_finite() {
+                if den[k] > 0.0 {
+                    *o = num[k] / den[k];
+                } else {
+                    missing = true;
+                }
+            }
+        }
+        if !missing {
+            return Ok(out);
+        }
+        r *= 2;
+    }
+}
+
+/// Box means of `raw` where known (0 elsewhere) and of the known indicator.
+fn window_sums(
+    raw: &Gray<f32>,
+    known: &[bool],
+    r: usize,
+) -> Result<(Vec<f32>, Vec<f32>), DehazeError> {
+    let (w, h) = raw.size();
+    let k = 2 * safe_radius(r, w) + 1;
+    let vals: Vec<f32> = raw
+        .as_slice()
+        .iter()
+        .zip(known)
+        .map(|(&v, &m)| if m { v } else { 0.0 })
+        .collect();
+    let ind: Vec<f32> = known.iter().map(|&m| f32::from(u8::from(m))).collect();
+    let (vals, ind) = (
+        Gray::from_vec(w, h, vals).expect("size matches"),
+        Gray::from_vec(w, h, ind).expect("size matches"),
+    );
+    let (mut num, mut den) = (Gray::new(w, h), Gray::new(w, h));
+    box_filter(&vals, &mut num, k, k, Border::Replicate)?;
+    box_filter(&ind, &mut den, k, k, Border::Replicate)?;
+    // The box sums run in f64 over 0/1 values, so `den > 0` exactly where a known pixel
+    // is within reach.
+    Ok((num.into_vec(), den.into_vec()))
+}
+
+/// Robust standard deviation of the pixel noise of the normalised S0 (Immerkaer, "Fast
+/// noise variance estimation", CVIU 1996, with a median instead of the mean): the mask
+/// `[1 -2 1] x [1 -2 1]` cancels every image term that is at most linear in x or in y (so
+/// smooth shading and gradients drop out) and turns white noise of deviation `sigma` into
+/// deviation `6 sigma`; `sigma = 1.4826 median(|response|) / 6` over the 3x3 windows of
+/// valid pixels. 0 for a noiseless smooth image or one smaller than 3x3.
+pub fn noise_sigma(input: &Normalized) -> f32 {
+    let (w, h) = input.s0.size();
+    if w < 3 || h < 3 {
+        return 0.0;
+    }
+    let s0 = input.s0.as_slice();
+    let mut r: Vec<f32> = Vec::with_capacity((w - 2) * (h - 2));
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let k = y * w + x;
+            let rows = [k - w, k, k + w];
+            if rows
+                .iter()
+                .any(|&c| !(input.valid[c - 1] && input.valid[c] && input.valid[c + 1]))
+            {
+                continue;
+            }
+            let d2 = |c: usize| s0[c - 1] - 2.0 * s0[c] + s0[c + 1];
+            r.push((d2(rows[0]) - 2.0 * d2(rows[1]) + d2(rows[2])).abs());
+        }
+    }
+    if r.is_empty() {
+        return 0.0;
+    }
+    let mid = r.len() / 2;
+    let med = *r.select_nth_unstable_by(mid, f32::total_cmp).1;
+    1.4826 * med / 6.0
+}
+
+/// Edge-preserving denoising of the normalised S0 before the inversion: the guided filter
+/// with S0 as its own guide, radius `radius` and `eps = 9 sigma^2` (`sigma` the noise of
+/// [`noise_sigma`]): windows whose variance is noise are averaged, edges well above the
+/// noise kept. Blended in by `1 - t` (`S0 + (1 - t)(S0_filtered - S0)`): the inversion
+/// multiplies noise by `1 / t`, so the haze-free parts (`t = 1`) stay as measured.
+/// Returns S0 unchanged for radius 0 or a noiseless image.
+pub fn denoise(input: &Normalized, t: &Gray<f32>, radius: usize) -> Result<Gray<f32>, DehazeError> {
+    let eps = 9.0 * f64::from(input.noise).powi(2);
+    if radius == 0 || eps <= 0.0 || !eps.is_finite() {
+        return Ok(input.s0.clone());
+    }
+    let radius = safe_radius(radius, input.s0.width());
+    let mut out = Gray::new(input.s0.width(), input.s0.height());
+    guided_filter(&input.s0, &input.s0, &mut out, radius, eps)?;
+    out.as_mut_slice()
+        .iter_mut()
+        .zip(input.s0.as_slice().iter().zip(t.as_slice()))
+        .for_each(|(d, (&s, &t))| *d = s + (1.0 - t) * (*d - s));
+    Ok(out)
+}

@@ -1,0 +1,329 @@
+//! Closed-form synthetic haze: the polarization method recovers the transmission and the
+//! radiance; haze-free, unpolarized, empty and saturated inputs and a global rescaling
+//! behave as documented.
+
+mod common;
+
+use common::{Haze, noise, observation};
+use polar_dehaze::{DehazeOptions, Method, WeakPolarization, dehaze};
+use polar_sensor::mask::SATURATED;
+
+/// Schechner et al.'s model as is: one `p` and `A_inf`, no guided filter, no denoising.
+fn unrefined() -> DehazeOptions {
+    DehazeOptions {
+        guided_radius: 0,
+        t_min: 0.05,
+        varying_airlight: false,
+        denoise_radius: 0,
+        ..DehazeOptions::default()
+    }
+}
+
+/// The dehazed radiance in the scene's unit.
+fn unitless(out: &polar_dehaze::Dehazed, scene: &Haze) -> Vec<f32> {
+    out.radiance
+        .as_slice()
+        .iter()
+        .map(|v| v / scene.unit)
+        .collect()
+}
+
+/// Largest |a - b| over the pixels where `keep` holds.
+fn max_err(a: &[f32], b: &[f32], keep: impl Fn(usize) -> bool) -> f32 {
+    (0..a.len())
+        .filter(|&k| keep(k))
+        .map(|k| (a[k] - b[k]).abs())
+        .fold(0.0, f32::max)
+}
+
+fn mean_err(a: &[f32], b: &[f32], keep: impl Fn(usize) -> bool) -> f32 {
+    let idx: Vec<usize> = (0..a.len()).filter(|&k| keep(k)).collect();
+    idx.iter().map(|&k| (a[k] - b[k]).abs()).sum::<f32>() / idx.len() as f32
+}
+
+#[test]
+fn polarization_recovers_p_airlight_and_transmission_unrefined() {
+    let scene = Haze::standard(16, 0.3);
+    let out = dehaze(&scene.observation(), &unrefined()).unwrap();
+    assert_eq!(out.method, Method::Polarization);
+    // The sky (16 of 96 rows) holds P / S0 = p exactly, so the envelope is p up to the
+    // quadratic angle field's misfit of the linear AoLP ramp (cos of < 1 deg).
+    assert!(
+        (out.airlight_dolp - 0.3).abs() < 1e-3,
+        "p = {}",
+        out.airlight_dolp
+    );
+    assert!(
+        (out.airlight_inf / 500.0 - 0.8).abs() < 1e-3,
+        "A_inf = {}",
+        out.airlight_inf
+    );
+    // t = 1 - P / (p A_inf) is exact per pixel but for the angle misfit: 1e-3.
+    let t = out.transmission.as_slice();
+    let below_sky = |k: usize| k / scene.w >= 16;
+    let et = max_err(t, &scene.t, below_sky);
+    assert!(et < 2e-3, "max |t error| {et}");
+    // Radiance error = t error * |S0 - A_inf| / t^2: below 0.02 of the unit where t >= 0.3.
+    let el = max_err(&unitless(&out, &scene), &scene.radiance, below_sky);
+    assert!(el < 0.02, "max radiance error {el}");
+    // The sky has t = 0, bounded at t_min.
+    assert!(t[..16 * scene.w].iter().all(|&v| v == 0.05));
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+}
+
+#[test]
+fn polarization_refined_transmission_is_close_and_depth_is_minus_log_t() {
+    let scene = Haze::standard(16, 0.3);
+    let out = dehaze(&scene.observation(), &DehazeOptions::default()).unwrap();
+    let t = out.transmission.as_slice();
+    // Two errors: the guided filter smooths t across the sky edge and copies some of the
+    // S0 texture into it; and the sky plane of p takes the hazy rows just below the sky
+    // (P / S0 = 0.85 p to p there) for sky and tilts, p reaching 0.26 instead of 0.3 at
+    // the bottom (a documented failure mode). Together below 0.05 mean, away from the edge.
+    let interior = |k: usize| k / scene.w >= 32;
+    let et = mean_err(t, &scene.t, interior);
+    assert!(et < 0.05, "mean |t error| {et}");
+    let el = mean_err(&unitless(&out, &scene), &scene.radiance, interior);
+    assert!(el < 0.05, "mean radiance error {el}");
+    for (d, t) in out.depth.as_slice().iter().zip(t) {
+        assert!((d + t.ln()).abs() < 1e-6 && *t >= 0.1 && *t <= 1.0);
+    }
+    // Schechner's single p (varying_airlight off) has only the filter's error (it copies
+    // part of the S0 texture, variance ~4e-3 against eps 1e-3, into t): below 0.03.
+    let fixed = DehazeOptions {
+        varying_airlight: false,
+        ..DehazeOptions::default()
+    };
+    let out = dehaze(&scene.observation(), &fixed).unwrap();
+    let et = mean_err(out.transmission.as_slice(), &scene.t, interior);
+    assert!(et < 0.03, "single p: mean |t error| {et}");
+}
+
+#[test]
+fn polarization_with_sensor_noise_stays_close() {
+    let scene = Haze::standard(16, 0.3);
+    let (mut s0, mut s1, mut s2) = scene.planes();
+    // Shot-noise-like: 1 % of S0 on each plane.
+    for (i, plane) in [&mut s0, &mut s1, &mut s2].into_iter().enumerate() {
+        let n = noise(11 + i as u64, plane.len());
+        let base: Vec<f32> = scene.planes().0;
+        for k in 0..plane.len() {
+            plane[k] += 0.01 * base[k] * n[k];
+        }
+    }
+    let out = dehaze(
+        &observation(scene.w, scene.h, s0, s1, s2),
+        &DehazeOptions::default(),
+    )
+    .unwrap();
+    assert!(
+        (out.airlight_dolp - 0.3).abs() < 0.02,
+        "p = {}",
+        out.airlight_dolp
+    );
+    // As the noiseless case (0.05, see there); the noise averages out in the filter.
+    let interior = |k: usize| k / scene.w >= 32;
+    let et = mean_err(out.transmission.as_slice(), &scene.t, interior);
+    assert!(et < 0.05, "mean |t error| {et}");
+}
+
+#[test]
+fn haze_free_unpolarized_input_is_left_unchanged_with_identity_fallback() {
+    let mut scene = Haze::standard(0, 0.0);
+    scene.t.iter_mut().for_each(|t| *t = 1.0);
+    let opts = DehazeOptions {
+        weak_fallback: WeakPolarization::Identity,
+        ..DehazeOptions::default()
+    };
+    let out = dehaze(&scene.observation(), &opts).unwrap();
+    assert!(out.transmission.as_slice().iter().all(|&t| t == 1.0));
+    assert!(out.depth.as_slice().iter().all(|&d| d == 0.0));
+    let (s0, _, _) = scene.planes();
+    // (S0 - A) / 1 + A rounds twice in f32: a few ulp.
+    let e = max_err(out.radiance.as_slice(), &s0, |_| true) / scene.unit;
+    assert!(e < 1e-6, "{e}");
+    assert!(out.warnings.iter().any(|w| w.contains("left unchanged")));
+}
+
+#[test]
+fn haze_free_input_gives_t_near_one_with_dark_channel_fallback() {
+    // Haze-free with dark squares in every 15x15 patch: the dark channel is 0.03 / A with
+    // A ~ 0.6 (the brightest pixel near the top dark-channel ones), so t ~ 0.95 and the
+    // radiance moves by (S0 - A)(1 / t - 1), on average below 3 % of the unit.
+    let mut scene = Haze::standard(0, 0.0);
+    scene.t.iter_mut().for_each(|t| *t = 1.0);
+    let out = dehaze(&scene.observation(), &DehazeOptions::default()).unwrap();
+    assert_eq!(out.method, Method::DarkChannel);
+    let tmin = out
+        .transmission
+        .as_slice()
+        .iter()
+        .copied()
+        .fold(1.0, f32::min);
+    assert!(tmin > 0.95, "min t {tmin}");
+    let (s0, _, _) = scene.planes();
+    let e = mean_err(out.radiance.as_slice(), &s0, |_| true) / scene.unit;
+    assert!(e < 0.03, "mean change {e}");
+}
+
+#[test]
+fn unpolarized_airlight_falls_back_to_dark_channel_with_warning() {
+    let scene = Haze::standard(16, 0.0);
+    let out = dehaze(&scene.observation(), &DehazeOptions::default()).unwrap();
+    assert_eq!(out.method, Method::DarkChannel);
+    assert!(
+        out.warnings
+            .iter()
+            .any(|w| w.contains("below min_airlight_dolp")),
+        "{:?}",
+        out.warnings
+    );
+    assert!(
+        out.transmission.as_slice().iter().any(|&t| t < 0.5),
+        "DCP still dehazes"
+    );
+}
+
+#[test]
+fn weak_airlight_polarization_below_threshold_falls_back() {
+    let scene = Haze::standard(16, 0.01);
+    let out = dehaze(&scene.observation(), &DehazeOptions::default()).unwrap();
+    assert_eq!(out.method, Method::DarkChannel);
+    assert!((out.airlight_dolp - 0.01).abs() < 1e-3);
+}
+
+fn all_finite(out: &polar_dehaze::Dehazed) -> bool {
+    [&out.radiance, &out.transmission, &out.depth]
+        .iter()
+        .all(|g| g.as_slice().iter().all(|v| v.is_finite()))
+        && out.airlight_inf.is_finite()
+        && out.airlight_dolp.is_finite()
+}
+
+#[test]
+fn all_zero_frame_is_finite_with_warning() {
+    for method in [Method::Polarization, Method::DarkChannel] {
+        let n = 32 * 24;
+        let obs = observation(32, 24, vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let opts = DehazeOptions {
+            method,
+            ..DehazeOptions::default()
+        };
+        let out = dehaze(&obs, &opts).unwrap();
+        assert!(all_finite(&out));
+        assert!(out.radiance.as_slice().iter().all(|&v| v == 0.0));
+        assert!(out.transmission.as_slice().iter().all(|&t| t == 1.0));
+        assert!(!out.warnings.is_empty());
+    }
+}
+
+#[test]
+fn saturated_frame_and_saturated_region_are_finite_with_warning() {
+    let scene = Haze::standard(16, 0.3);
+    for region in [true, false] {
+        let obs = scene.observation();
+        let mut flags = obs.flags.clone();
+        for (k, f) in flags.as_mut_slice().iter_mut().enumerate() {
+            let (x, y) = (k % scene.w, k / scene.w);
+            if !region || (40..60).contains(&x) && (50..70).contains(&y) {
+                *f |= SATURATED;
+            }
+        }
+        let out = dehaze(&obs.with_flags(flags), &DehazeOptions::default()).unwrap();
+        assert!(all_finite(&out));
+        assert!(
+            out.warnings.iter().any(|w| w.contains("saturated")),
+            "{:?}",
+            out.warnings
+        );
+        if region {
+            // The saturated square's t is interpolated from its surroundings (true t there
+            // spans 0.52 to 0.62).
+            let (t, truth) = (
+                out.transmission.as_slice()[60 * scene.w + 50],
+                scene.t[60 * scene.w + 50],
+            );
+            assert!((t - truth).abs() < 0.05, "t = {t}, true {truth}");
+        }
+    }
+}
+
+#[test]
+fn nan_and_tiny_images_do_not_panic() {
+    for (w, h) in [(1, 1), (2, 2), (3, 1)] {
+        let n = w * h;
+        let mut s0 = vec![1.0; n];
+        s0[0] = f32::NAN;
+        let s1 = vec![f32::INFINITY; n];
+        for method in [Method::Polarization, Method::DarkChannel] {
+            let opts = DehazeOptions {
+                method,
+                ..DehazeOptions::default()
+            };
+            let out = dehaze(
+                &observation(w, h, s0.clone(), s1.clone(), vec![0.0; n]),
+                &opts,
+            )
+            .unwrap();
+            assert!(all_finite(&out), "{w}x{h} {method}");
+        }
+    }
+}
+
+#[test]
+fn global_scale_37_gives_identical_transmission_and_scaled_radiance() {
+    let scene = Haze::standard(16, 0.3);
+    let (s0, s1, s2) = scene.planes();
+    let x37 = |v: &[f32]| v.iter().map(|x| x * 37.0).collect::<Vec<_>>();
+    let a = observation(scene.w, scene.h, s0.clone(), s1.clone(), s2.clone());
+    let b = observation(scene.w, scene.h, x37(&s0), x37(&s1), x37(&s2));
+    for method in [Method::Polarization, Method::DarkChannel] {
+        let opts = DehazeOptions {
+            method,
+            ..DehazeOptions::default()
+        };
+        let (ra, rb) = (dehaze(&a, &opts).unwrap(), dehaze(&b, &opts).unwrap());
+        // Normalising by s0_scale rounds S0 * 37 / (q * 37) and S0 / q differently by an
+        // ulp; that is the only difference, so 1e-5 bounds it after the filters.
+        let et = max_err(
+            ra.transmission.as_slice(),
+            rb.transmission.as_slice(),
+            |_| true,
+        );
+        assert!(et < 1e-5, "{method}: t differs by {et}");
+        let er = (0..s0.len())
+            .map(|k| {
+                (ra.radiance.as_slice()[k] * 37.0 - rb.radiance.as_slice()[k]).abs()
+                    / (rb.radiance.as_slice()[k].abs() + 37.0)
+            })
+            .fold(0.0, f32::max);
+        assert!(er < 1e-4, "{method}: radiance relative difference {er}");
+        assert!((ra.airlight_inf * 37.0 / rb.airlight_inf - 1.0).abs() < 1e-5);
+        assert_eq!(ra.airlight_dolp, rb.airlight_dolp);
+    }
+}
+
+#[test]
+fn method_names_round_trip_and_bad_options_are_errors() {
+    for m in [Method::Polarization, Method::DarkChannel] {
+        assert_eq!(m.to_string().parse::<Method>().unwrap(), m);
+    }
+    assert!("dcp".parse::<Method>().is_err());
+    let scene = Haze::standard(16, 0.3);
+    for opts in [
+        DehazeOptions {
+            t_min: 0.0,
+            ..DehazeOptions::default()
+        },
+        DehazeOptions {
+            guided_eps: f32::NAN,
+            ..DehazeOptions::default()
+        },
+        DehazeOptions {
+            dcp_patch: 14,
+            ..DehazeOptions::default()
+        },
+    ] {
+        assert!(dehaze(&scene.observation(), &opts).is_err());
+    }
+}

@@ -1,0 +1,152 @@
+//! Material classification from polarization: background, opaque dielectric, metal.
+//!
+//! [`classify`] labels every pixel `0` background, `1` opaque dielectric, `2` metal (`3`
+//! transparent where a transparency mask is given). The physics rule needs no training:
+//! a metal reflects unpolarized light only weakly polarized and always across the plane
+//! of incidence (Wolff 1990), whereas a dielectric either polarizes specular reflection
+//! strongly (above any metal's Fresnel curve) or sends diffuse light polarized along the
+//! surface azimuth; see [`rule`]. Inputs are an [`Observation`] (scale-free: S0 is divided
+//! by its `s0_scale`), optional camera-frame normals, an optional object mask (else
+//! [`foreground::estimate`]) and an optional transparency mask.
+
+pub mod cues;
+pub mod features;
+pub mod foreground;
+pub mod fresnel_cues;
+pub mod rule;
+
+use polar_image::{Gray, Image};
+use polar_sensor::Observation;
+use thiserror::Error;
+
+/// Label of background pixels (floors, walls, sky), as in `gt/material.png`.
+pub const BACKGROUND: u8 = 0;
+/// Label of opaque dielectric pixels.
+pub const DIELECTRIC: u8 = 1;
+/// Label of metal pixels.
+pub const METAL: u8 = 2;
+/// Label of transparent pixels (only where a transparency mask is given).
+pub const TRANSPARENT: u8 = 3;
+
+/// Errors of material classification.
+#[derive(Debug, Error)]
+pub enum MaterialError {
+    /// The observation has no pixels.
+    #[error("empty observation ({0}x{1})")]
+    Empty(usize, usize),
+    /// An optional input does not have the observation's size.
+    #[error("{what} is {got:?}, the observation {expected:?}")]
+    SizeMismatch {
+        /// Which input.
+        what: &'static str,
+        /// The observation's `(width, height)`.
+        expected: (usize, usize),
+        /// The input's `(width, height)`.
+        got: (usize, usize),
+    },
+    /// An image-processing primitive failed.
+    #[error(transparent)]
+    Imgproc(#[from] polar_imgproc::Error),
+}
+
+/// Which classifier decides dielectric versus metal.
+#[derive(Clone, Debug)]
+pub enum Classifier {
+    /// The training-free Fresnel / AoLP-phase rule of [`rule`].
+    Physics,
+}
+
+/// Options of [`classify`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialOptions {
+    /// Give every connected object region the label its pixels' evidence favours
+    /// (a region is one material far more often than not); off = per-pixel labels.
+    pub smooth_regions: bool,
+}
+
+impl Default for MaterialOptions {
+    fn default() -> Self {
+        Self {
+            smooth_regions: true,
+        }
+    }
+}
+
+/// The result of [`classify`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialMap {
+    /// Per-pixel label: [`BACKGROUND`], [`DIELECTRIC`], [`METAL`] or [`TRANSPARENT`].
+    pub labels: Gray<u8>,
+    /// Confidence of the label in `[0, 1]` (0.5 = a coin toss between dielectric and metal).
+    pub confidence: Gray<f32>,
+}
+
+/// Labels the pixels of `obs`.
+///
+/// `normals`: camera-frame unit normals (e.g. from shape from polarization; `(0,0,0)` =
+/// unknown) give the zenith and azimuth at every pixel; without them the azimuth is taken
+/// from the object silhouettes. `foreground`: non-zero on object pixels; without it
+/// [`foreground::estimate`] decides. `transparent`: non-zero on transparent pixels, which
+/// are labelled [`TRANSPARENT`] and left out of the opaque classes.
+pub fn classify(
+    obs: &Observation,
+    normals: Option<&Image<f32, 3>>,
+    foreground: Option<&Gray<u8>>,
+    transparent: Option<&Gray<u8>>,
+    clf: &Classifier,
+    opts: &MaterialOptions,
+) -> Result<MaterialMap, MaterialError> {
+    let size = obs.size();
+    check_size("foreground", size, foreground.map(|m| m.size()))?;
+    check_size("transparent", size, transparent.map(|m| m.size()))?;
+    let feats = features::Features::new(obs)?;
+    let (w, h) = size;
+    let clear = |m: Option<&Gray<u8>>, k: usize| m.is_some_and(|m| m.as_slice()[k] != 0);
+    let mut fg = match foreground {
+        Some(m) => m.as_slice().iter().map(|&v| v != 0).collect(),
+        None => foreground::estimate(&feats)?,
+    };
+    for (k, v) in fg.iter_mut().enumerate() {
+        *v &= !clear(transparent, k);
+    }
+    let cues = match normals {
+        Some(n) => cues::from_normals(obs, &feats, n)?,
+        None => cues::from_silhouette(&feats, &fg)?,
+    };
+    let Classifier::Physics = clf;
+    let metal = rule::metal_probability(&feats, &cues, &fg, opts.smooth_regions)?;
+    let mut labels = Vec::with_capacity(w * h);
+    let mut conf = Vec::with_capacity(w * h);
+    for k in 0..w * h {
+        let (l, c) = if clear(transparent, k) {
+            (TRANSPARENT, 1.0)
+        } else if !fg[k] {
+            (BACKGROUND, 1.0)
+        } else if metal[k] > 0.5 {
+            (METAL, metal[k])
+        } else {
+            (DIELECTRIC, 1.0 - metal[k])
+        };
+        labels.push(l);
+        conf.push(c);
+    }
+    Ok(MaterialMap {
+        labels: Gray::from_vec(w, h, labels).expect("size of the observation"),
+        confidence: Gray::from_vec(w, h, conf).expect("size of the observation"),
+    })
+}
+
+fn check_size(
+    what: &'static str,
+    expected: (usize, usize),
+    got: Option<(usize, usize)>,
+) -> Result<(), MaterialError> {
+    match got {
+        Some(g) if g != expected => Err(MaterialError::SizeMismatch {
+            what,
+            expected,
+            got: g,
+        }),
+        _ => Ok(()),
+    }
+}

@@ -1,0 +1,169 @@
+//! The training-free physics rule.
+//!
+//! - Fresnel cue (Wolff 1990): a DoLP above the largest specular DoLP a metal of
+//!   [`crate::fresnel_cues::METAL_INDICES`] reaches at that zenith cannot come from a
+//!   metal. Where the zenith is the silhouette's sphere prior, the envelope may be taken
+//!   [`PRIOR_MARGIN_DEG`] further toward grazing (the envelope is a running maximum over
+//!   the zenith), trading missed dielectrics for fewer false ones.
+//! - Phase cue: light polarized along the surface azimuth (phase `> 0`) is diffuse light
+//!   leaving a dielectric; metals have no diffuse lobe, so their light is polarized
+//!   across the azimuth. Polarization across the azimuth decides nothing by itself: a
+//!   dielectric's specular reflection is polarized the same way.
+//!
+//! A region is dielectric when enough of its pixels pass the Fresnel cue or when its
+//! DoLP-weighted phase leans toward the azimuth; else metal (a metal never shows either).
+
+use crate::MaterialError;
+use crate::cues::Cues;
+use crate::features::Features;
+use crate::fresnel_cues::FresnelTable;
+use polar_image::Gray;
+use polar_imgproc::mask::components;
+use polar_imgproc::{Border, box_filter};
+
+/// DoLP margin above the metal envelope before the Fresnel cue fires (rendering or
+/// sensor deviations of a few percent), added to three windowed noise sigmas.
+pub const FRESNEL_MARGIN: f32 = 0.03;
+/// Widening of the zenith of the sphere prior toward grazing, degrees (0: the prior as
+/// is, which on the dev set classified more pixels right than 15°).
+pub const PRIOR_MARGIN_DEG: f32 = 0.0;
+/// Fraction of a region's pixels above the metal envelope at which the Fresnel cue
+/// changes its vote (isolated pixels are noise or demosaicing edges).
+const OVER_FRACTION: f32 = 0.06;
+/// DoLP-weighted phase at which the phase cue changes its vote (a metal's is negative).
+const PHASE_LEAN: f32 = 0.0;
+/// Phase change that moves the phase cue by one unit of score.
+const PHASE_SCALE: f32 = 0.2;
+/// With measured normals, the phase cue uses only pixels seen beyond this zenith: nearer
+/// normal incidence diffuse polarization vanishes (it grows as `sin² θ`) and any
+/// specular reflection, a dielectric's included, sets the phase.
+const PHASE_MIN_ZENITH_DEG: f32 = 50.0;
+
+/// The metal envelope at pixel `k`: the largest metal specular DoLP at its zenith.
+fn envelope(cues: &Cues, table: &FresnelTable, k: usize) -> f32 {
+    let z = cues.zenith[k];
+    if !z.is_finite() {
+        return table.metal_ceiling();
+    }
+    let z = if cues.prior {
+        (z + PRIOR_MARGIN_DEG.to_radians()).min(std::f32::consts::FRAC_PI_2)
+    } else {
+        z
+    };
+    table.metal_max(z)
+}
+
+/// `true` where the pixel's DoLP is above the metal envelope with margin.
+fn over_envelope(f: &Features, cues: &Cues, table: &FresnelTable, k: usize) -> bool {
+    f.valid[k] && f.dolp[k] > envelope(cues, table, k) + FRESNEL_MARGIN + 3.0 * f.window_noise()
+}
+
+/// Running sums of one region.
+#[derive(Clone, Copy, Default)]
+struct Tally {
+    valid: f32,
+    over: f32,
+    rho_phase: f32,
+    rho: f32,
+}
+
+impl Tally {
+    fn add(&mut self, f: &Features, cues: &Cues, table: &FresnelTable, k: usize) {
+        if !f.valid[k] {
+            return;
+        }
+        self.valid += 1.0;
+        self.over += f32::from(u8::from(over_envelope(f, cues, table, k)));
+        let ph = cues.phase[k];
+        let grazing = cues.prior || cues.zenith[k] > PHASE_MIN_ZENITH_DEG.to_radians();
+        if ph.is_finite() && grazing && f.dolp[k] > 3.0 * f.window_noise() {
+            self.rho_phase += f.dolp[k] * ph;
+            self.rho += f.dolp[k];
+        }
+    }
+
+    /// Dielectric score: `> 0` dielectric, `< 0` metal, in units of the cues' scales.
+    fn score(&self) -> f32 {
+        let over = self.over / self.valid.max(1.0);
+        let fresnel = (over - OVER_FRACTION) / OVER_FRACTION;
+        let phase = if self.rho > 0.0 {
+            (self.rho_phase / self.rho - PHASE_LEAN) / PHASE_SCALE
+        } else {
+            -1.0
+        };
+        fresnel.max(phase)
+    }
+}
+
+/// Probability of metal from a dielectric score.
+fn metal_from(score: f32) -> f32 {
+    1.0 / (1.0 + (2.0 * score.clamp(-10.0, 10.0)).exp())
+}
+
+/// Probability of metal per pixel (0.5 outside `fg`). With `smooth`, each 8-connected
+/// region of `fg` gets one value from its tallies; else each pixel from the tallies of
+/// the `fg` pixels in a [`crate::features::WINDOW`]² window around it.
+pub fn metal_probability(
+    f: &Features,
+    cues: &Cues,
+    fg: &[bool],
+    smooth: bool,
+) -> Result<Vec<f32>, MaterialError> {
+    let table = FresnelTable::new();
+    let (w, h) = (f.width, f.height);
+    let n = w * h;
+    if smooth {
+        let (lab, count) = components(fg, w, h)?;
+        let mut t = vec![Tally::default(); count + 1];
+        for k in 0..n {
+            if lab[k] != 0 {
+                t[lab[k] as usize].add(f, cues, &table, k);
+            }
+        }
+        return Ok((0..n)
+            .map(|k| {
+                if fg[k] {
+                    metal_from(t[lab[k] as usize].score())
+                } else {
+                    0.5
+                }
+            })
+            .collect());
+    }
+    let mut planes = [
+        vec![0.0f32; n],
+        vec![0.0f32; n],
+        vec![0.0f32; n],
+        vec![0.0f32; n],
+    ];
+    for j in 0..n {
+        if fg[j] {
+            let mut t = Tally::default();
+            t.add(f, cues, &table, j);
+            [planes[0][j], planes[1][j], planes[2][j], planes[3][j]] =
+                [t.valid, t.over, t.rho_phase, t.rho];
+        }
+    }
+    let k = crate::features::WINDOW;
+    let mut sums = Vec::with_capacity(4);
+    for p in planes {
+        let src = Gray::from_vec(w, h, p).expect("size");
+        let mut dst = Gray::new(w, h);
+        box_filter(&src, &mut dst, k, k, Border::Reflect101)?;
+        sums.push(dst.into_vec());
+    }
+    Ok((0..n)
+        .map(|j| {
+            if !fg[j] {
+                return 0.5;
+            }
+            let t = Tally {
+                valid: sums[0][j],
+                over: sums[1][j],
+                rho_phase: sums[2][j],
+                rho: sums[3][j],
+            };
+            metal_from(t.score())
+        })
+        .collect())
+}

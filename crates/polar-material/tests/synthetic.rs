@@ -1,0 +1,311 @@
+//! Analytic scenes: spheres seen orthographically over an unpolarized floor, with the
+//! DoLP and AoLP that Fresnel's equations give for specular reflection (dielectric,
+//! metal) or diffuse emission (dielectric) of unpolarized light, and named hard cases.
+
+use polar_image::{Gray, Image};
+use polar_material::fresnel_cues::specular_dolp;
+use polar_material::{
+    BACKGROUND, Classifier, DIELECTRIC, METAL, MaterialOptions, TRANSPARENT, classify,
+};
+use polar_optics::pixel_frame::CameraModel;
+use polar_sensor::{Observation, StokesPlanes};
+
+const W: usize = 96;
+const H: usize = 48;
+
+/// How a sphere sends light: specular reflection with index `n + ik`, or diffuse.
+#[derive(Clone, Copy)]
+enum Surface {
+    Specular(f64, f64),
+    Diffuse(f64),
+}
+
+/// DoLP of light leaving a dielectric of index `n` after subsurface scattering, at
+/// emission zenith `t` (Atkinson & Hancock 2006).
+fn diffuse_dolp(t: f64, n: f64) -> f64 {
+    let s2 = t.sin().powi(2);
+    let num = (n - 1.0 / n).powi(2) * s2;
+    let den = 2.0 + 2.0 * n * n - (n + 1.0 / n).powi(2) * s2 + 4.0 * t.cos() * (n * n - s2).sqrt();
+    num / den
+}
+
+/// Two spheres of radius 20 px centred at x = 24 and x = 72, and the pixel's
+/// `(sphere index, zenith, azimuth)`; azimuth measured counterclockwise from image +x.
+fn sphere_at(x: usize, y: usize) -> Option<(usize, f64, f64)> {
+    for (i, cx) in [24.0, 72.0].into_iter().enumerate() {
+        let (dx, dy) = (x as f64 + 0.5 - cx, -(y as f64 + 0.5 - 24.0));
+        let r = dx.hypot(dy) / 20.0;
+        if r < 1.0 {
+            return Some((i, r.asin(), dy.atan2(dx)));
+        }
+    }
+    None
+}
+
+/// The observation of the two spheres (`surfaces[i]`) over a floor of S0 0.4.
+fn scene(surfaces: [Surface; 2]) -> (Observation, Image<f32, 3>, Gray<u8>) {
+    let mut p = StokesPlanes::new(W, H);
+    let mut normals = Image::<f32, 3>::new(W, H);
+    let mut fg = Gray::<u8>::new(W, H);
+    for y in 0..H {
+        for x in 0..W {
+            let k = y * W + x;
+            let (s0, dolp, aolp) = match sphere_at(x, y) {
+                None => (0.4, 0.0, 0.0),
+                Some((i, ze, az)) => {
+                    normals.pixels_mut()[k] = [
+                        (ze.sin() * az.cos()) as f32,
+                        (ze.sin() * az.sin()) as f32,
+                        ze.cos() as f32,
+                    ];
+                    fg.as_mut_slice()[k] = 1;
+                    match surfaces[i] {
+                        Surface::Specular(n, kk) => (
+                            0.6,
+                            specular_dolp(ze, n, kk),
+                            az + std::f64::consts::FRAC_PI_2,
+                        ),
+                        Surface::Diffuse(n) => (0.7, diffuse_dolp(ze, n), az),
+                    }
+                }
+            };
+            p.s0.as_mut_slice()[k] = s0 as f32;
+            p.s1.as_mut_slice()[k] = (s0 * dolp * (2.0 * aolp).cos()) as f32;
+            p.s2.as_mut_slice()[k] = (s0 * dolp * (2.0 * aolp).sin()) as f32;
+        }
+    }
+    let planes = StokesPlanes::from_linear_stokes(&p.linear_stokes());
+    (
+        Observation::new(planes, CameraModel::Orthographic),
+        normals,
+        fg,
+    )
+}
+
+/// Share of sphere `i`'s pixels labelled `label`.
+fn share(labels: &Gray<u8>, i: usize, label: u8) -> f64 {
+    let (mut n, mut hit) = (0, 0);
+    for y in 0..H {
+        for x in 0..W {
+            if let Some((j, _, _)) = sphere_at(x, y)
+                && j == i
+            {
+                n += 1;
+                hit += usize::from(labels.as_slice()[y * W + x] == label);
+            }
+        }
+    }
+    hit as f64 / n as f64
+}
+
+fn run(obs: &Observation, normals: Option<&Image<f32, 3>>, fg: Option<&Gray<u8>>) -> Gray<u8> {
+    classify(
+        obs,
+        normals,
+        fg,
+        None,
+        &Classifier::Physics,
+        &MaterialOptions::default(),
+    )
+    .expect("classify")
+    .labels
+}
+
+/// Glass-like dielectric (n = 1.5) specular sphere next to a gold sphere: the
+/// dielectric exceeds every metal's Fresnel DoLP near Brewster's angle, the gold never.
+/// Region smoothing makes each sphere one label, so the shares are 1 or 0; 0.95 leaves
+/// room for a rim pixel the window blurs.
+#[test]
+fn specular_dielectric_and_gold_spheres_are_told_apart() {
+    let (obs, normals, fg) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+    for (name, n, m) in [
+        ("mask", None, Some(&fg)),
+        ("mask + normals", Some(&normals), Some(&fg)),
+        ("automatic mask", None, None),
+    ] {
+        let l = run(&obs, n, m);
+        assert!(
+            share(&l, 0, DIELECTRIC) > 0.95,
+            "{name}: {}",
+            share(&l, 0, DIELECTRIC)
+        );
+        assert!(
+            share(&l, 1, METAL) > 0.95,
+            "{name}: {}",
+            share(&l, 1, METAL)
+        );
+    }
+}
+
+/// A diffuse dielectric is weakly polarized (below the metal envelope) but along the
+/// azimuth: the silhouette phase cue must call it dielectric, the aluminium metal.
+#[test]
+fn diffuse_dielectric_is_told_from_aluminium_by_the_aolp_phase() {
+    let (obs, normals, fg) = scene([Surface::Diffuse(1.5), Surface::Specular(1.0, 6.6)]);
+    for n in [None, Some(&normals)] {
+        let l = run(&obs, n, Some(&fg));
+        assert!(
+            share(&l, 0, DIELECTRIC) > 0.95,
+            "{}",
+            share(&l, 0, DIELECTRIC)
+        );
+        assert!(share(&l, 1, METAL) > 0.95, "{}", share(&l, 1, METAL));
+    }
+}
+
+/// Scaling S0, S1, S2 by 37 (exposure) changes no label and no confidence beyond float
+/// rounding of the normalised Stokes values.
+#[test]
+fn scale_invariance_times_37() {
+    let (obs, _, _) = scene([Surface::Specular(1.5, 0.0), Surface::Diffuse(1.4)]);
+    let mut scaled = obs.planes.linear_stokes();
+    scaled.as_mut_slice().iter_mut().for_each(|v| *v *= 37.0);
+    let obs37 = Observation::new(
+        StokesPlanes::from_linear_stokes(&scaled),
+        CameraModel::Orthographic,
+    );
+    let opts = MaterialOptions::default();
+    let a = classify(&obs, None, None, None, &Classifier::Physics, &opts).unwrap();
+    let b = classify(&obs37, None, None, None, &Classifier::Physics, &opts).unwrap();
+    assert_eq!(a.labels, b.labels);
+    for (x, y) in a.confidence.as_slice().iter().zip(b.confidence.as_slice()) {
+        assert!((x - y).abs() < 1e-4, "{x} {y}");
+    }
+}
+
+/// Transparent pixels take label 3 and leave the opaque classes.
+#[test]
+fn transparent_mask_wins() {
+    let (obs, _, fg) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+    let mut t = Gray::<u8>::new(W, H);
+    t.as_mut_slice()[24 * W + 24] = 255;
+    let out = classify(
+        &obs,
+        None,
+        Some(&fg),
+        Some(&t),
+        &Classifier::Physics,
+        &MaterialOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(out.labels.as_slice()[24 * W + 24], TRANSPARENT);
+    assert_eq!(out.labels.as_slice()[0], BACKGROUND);
+}
+
+fn uniform(w: usize, h: usize, s0: f32, s1: f32) -> Observation {
+    let mut p = StokesPlanes::new(w, h);
+    p.s0.as_mut_slice().fill(s0);
+    p.s1.as_mut_slice().fill(s1);
+    Observation::new(
+        StokesPlanes::from_linear_stokes(&p.linear_stokes()),
+        CameraModel::Orthographic,
+    )
+}
+
+fn all_background(obs: &Observation) -> bool {
+    let out = classify(
+        obs,
+        None,
+        None,
+        None,
+        &Classifier::Physics,
+        &MaterialOptions::default(),
+    )
+    .expect("a finite result");
+    out.confidence
+        .as_slice()
+        .iter()
+        .all(|c| c.is_finite() && (0.0..=1.0).contains(c))
+        && out.labels.as_slice().iter().all(|&l| l == BACKGROUND)
+}
+
+#[test]
+fn all_dark_frame_is_background() {
+    assert!(all_background(&uniform(16, 16, 0.0, 0.0)));
+}
+
+#[test]
+fn dolp_zero_everywhere_is_background() {
+    assert!(all_background(&uniform(32, 32, 0.5, 0.0)));
+}
+
+#[test]
+fn tiny_images_are_classified() {
+    for (w, h) in [(1, 1), (2, 2), (1, 5)] {
+        assert!(all_background(&uniform(w, h, 1.0, 0.0)), "{w}x{h}");
+        let out = classify(
+            &uniform(w, h, 1.0, 0.5),
+            None,
+            None,
+            None,
+            &Classifier::Physics,
+            &MaterialOptions::default(),
+        )
+        .expect("tiny polarized image");
+        assert_eq!(out.labels.size(), (w, h));
+    }
+}
+
+#[test]
+fn nan_s0_and_saturated_pixels_do_not_panic() {
+    let (obs, normals, _) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+    let mut planes = obs.planes.clone();
+    planes.s0.as_mut_slice()[24 * W + 20] = f32::NAN;
+    planes.s1.as_mut_slice()[24 * W + 21] = f32::INFINITY;
+    let mut flags = Gray::<u8>::new(W, H);
+    flags.as_mut_slice()[24 * W + 72] = polar_sensor::mask::SATURATED;
+    let mut nn = normals.clone();
+    nn.pixels_mut()[5] = [f32::NAN, 0.0, 1.0];
+    let bad = Observation::new(planes, CameraModel::Orthographic).with_flags(flags);
+    let out = classify(
+        &bad,
+        Some(&nn),
+        None,
+        None,
+        &Classifier::Physics,
+        &MaterialOptions::default(),
+    )
+    .expect("finite result");
+    assert!(out.confidence.as_slice().iter().all(|c| c.is_finite()));
+    assert!(share(&out.labels, 0, DIELECTRIC) > 0.9);
+}
+
+#[test]
+fn per_pixel_labels_without_region_smoothing() {
+    let (obs, _, fg) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+    let opts = MaterialOptions {
+        smooth_regions: false,
+    };
+    let l = classify(&obs, None, Some(&fg), None, &Classifier::Physics, &opts)
+        .unwrap()
+        .labels;
+    // Per pixel the gold sphere has no dielectric evidence anywhere; the dielectric only
+    // where its DoLP clears the envelope (a band around Brewster's angle).
+    assert!(share(&l, 1, METAL) > 0.95, "{}", share(&l, 1, METAL));
+    assert!(
+        share(&l, 0, DIELECTRIC) > 0.3,
+        "{}",
+        share(&l, 0, DIELECTRIC)
+    );
+}
+
+#[test]
+fn size_mismatch_is_an_error() {
+    let obs = uniform(8, 8, 1.0, 0.0);
+    let fg = Gray::<u8>::new(4, 8);
+    let n = Image::<f32, 3>::new(8, 4);
+    let opts = MaterialOptions::default();
+    assert!(classify(&obs, None, Some(&fg), None, &Classifier::Physics, &opts).is_err());
+    assert!(classify(&obs, Some(&n), None, None, &Classifier::Physics, &opts).is_err());
+    assert!(
+        classify(
+            &uniform(0, 0, 1.0, 0.0),
+            None,
+            None,
+            None,
+            &Classifier::Physics,
+            &opts
+        )
+        .is_err()
+    );
+}

@@ -1,0 +1,310 @@
+//! Runs both shape-from-polarization methods on the `sfp-*` samples of a dataset and
+//! prints the angular error of the normals over object pixels (gt material label != 0),
+//! split by the sensor noise level, with timings.
+//!
+//! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]`
+//! (default `/work/data/dev`). The Stokes planes come from the raw mosaic (residual
+//! demosaicing, saturation flagged) as a camera would give them; `--exr` uses
+//! `stokes.exr` instead. `--debug DIR` writes foreground / reflection / error pictures.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use polar_image::{Gray, Image};
+use polar_imgproc::angular_error;
+use polar_optics::pixel_frame::CameraModel;
+use polar_sensor::mask::validity_mask;
+use polar_sensor::{DemosaicMethod, Observation, StokesPlanes, stokes_planes};
+use polar_shape::{Integrator, Method, ShapeOptions, estimate_shape};
+
+struct Args {
+    root: PathBuf,
+    exr: bool,
+    debug: Option<PathBuf>,
+}
+
+fn args() -> Args {
+    let mut a = Args {
+        root: "/work/data/dev".into(),
+        exr: false,
+        debug: None,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(s) = it.next() {
+        match s.as_str() {
+            "--exr" => a.exr = true,
+            "--debug" => a.debug = it.next().map(PathBuf::from),
+            _ => a.root = s.into(),
+        }
+    }
+    a
+}
+
+fn observation(dir: &Path, fov: f64, exr: bool) -> Observation {
+    let camera = CameraModel::Pinhole { fov_x_deg: fov };
+    if exr {
+        let img =
+            polar_io::read_exr(dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS).unwrap();
+        Observation::new(StokesPlanes::from_linear_stokes(&img), camera)
+    } else {
+        let png = polar_io::read_mosaic(dir.join("raw.png")).unwrap();
+        let m = DemosaicMethod::Residual;
+        let planes = stokes_planes(&png.image, m).unwrap();
+        let flags = validity_mask(
+            &png.image,
+            u32::from(png.bit_depth.max_value()),
+            m,
+            &planes.s0,
+        );
+        Observation::new(planes, camera).with_flags(flags)
+    }
+}
+
+#[derive(Default)]
+struct Acc {
+    means: Vec<f64>,
+    medians: Vec<f64>,
+    pooled: Vec<(f64, usize)>,
+    secs: f64,
+    ious: Vec<f64>,
+}
+
+fn main() {
+    let a = args();
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&a.root)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("sfp-"))
+        })
+        .collect();
+    dirs.sort();
+    if let Some(first) = dirs.first() {
+        speed(first);
+    }
+    let methods = [Method::Local, Method::Global];
+    let mut acc: std::collections::BTreeMap<(String, String), Acc> = Default::default();
+    for dir in &dirs {
+        let s = polar_io::read_sample(dir).unwrap();
+        let noise = s.meta["sensor"]["noise"]["name"]
+            .as_str()
+            .unwrap_or("?")
+            .to_string();
+        let fov = s.meta["camera"]["fov_deg"].as_f64().expect("fov_deg");
+        let obs = observation(dir, fov, a.exr);
+        let gt = s.gt.normal.as_ref().expect("gt normal");
+        let label = s.gt.material.as_ref().expect("gt material");
+        let mask = Gray::from_vec(
+            label.width(),
+            label.height(),
+            label.as_slice().iter().map(|&l| u8::from(l != 0)).collect(),
+        )
+        .unwrap();
+        let name = dir.file_name().unwrap().to_string_lossy().to_string();
+        let mut line = format!("{name} {noise:9}");
+        for m in methods {
+            let opts = ShapeOptions {
+                method: m,
+                integrator: Integrator::Poisson,
+                ior: None,
+            };
+            let t = Instant::now();
+            let shape = estimate_shape(&obs, &opts).unwrap();
+            let secs = t.elapsed().as_secs_f64();
+            let st = angular_error(&shape.normal, gt, Some(&mask)).unwrap();
+            let e = acc.entry((m.to_string(), noise.clone())).or_default();
+            let missing = count_missing(&shape.normal, &mask);
+            let iou = polar_imgproc::iou(&shape.foreground, &mask)
+                .unwrap()
+                .unwrap_or(0.0);
+            e.ious.push(iou);
+            e.secs += secs;
+            if let Some(st) = st {
+                e.means.push(st.mean);
+                e.medians.push(st.median);
+                e.pooled.push((st.mean, st.count));
+                line += &format!(
+                    " | {m}: mean {:5.1} med {:5.1} <11.25 {:4.0}% miss {missing:4} iou {iou:.2} ({:.0} ms)",
+                    st.mean,
+                    st.median,
+                    st.pct_below_11_25,
+                    secs * 1e3
+                );
+            }
+            let (ez, ea) = split_error(&shape.normal, gt, &mask, fov);
+            line += &format!(" zen {ez:4.1} az {ea:4.1}");
+            if let Some(d) = &a.debug {
+                debug_pictures(d, &name, &m.to_string(), &shape, gt, &mask);
+            }
+        }
+        println!("{line}");
+        if let Some(d) = &a.debug {
+            cue_pictures(d, &name, &obs);
+        }
+    }
+    println!(
+        "\nsummary (per-sample mean of mean / median of per-sample medians, pooled pixel mean):"
+    );
+    for ((m, noise), e) in &acc {
+        let n = e.means.len().max(1) as f64;
+        let mut med = e.medians.clone();
+        med.sort_by(f64::total_cmp);
+        let (num, den) = e
+            .pooled
+            .iter()
+            .fold((0.0, 0usize), |s, (m, c)| (s.0 + m * *c as f64, s.1 + c));
+        println!(
+            "{m:6} {noise:9}: mean {:5.2}  median-of-medians {:5.2}  mean-of-medians {:5.2}  pooled mean {:5.2}  fg IoU {:.2} time/sample {:.1} ms",
+            e.means.iter().sum::<f64>() / n,
+            med.get(med.len() / 2).copied().unwrap_or(f64::NAN),
+            e.medians.iter().sum::<f64>() / n,
+            num / den.max(1) as f64,
+            e.ious.iter().sum::<f64>() / n,
+            e.secs / n * 1e3
+        );
+    }
+}
+
+fn count_missing(n: &Image<f32, 3>, mask: &Gray<u8>) -> usize {
+    n.pixels()
+        .iter()
+        .zip(mask.as_slice())
+        .filter(|(p, m)| **m != 0 && p.iter().all(|v| *v == 0.0))
+        .count()
+}
+
+fn debug_pictures(
+    dir: &Path,
+    name: &str,
+    m: &str,
+    shape: &polar_shape::Shape,
+    gt: &Image<f32, 3>,
+    mask: &Gray<u8>,
+) {
+    std::fs::create_dir_all(dir).unwrap();
+    let (w, h) = shape.normal.size();
+    // Left: estimate as RGB normal map; middle: ground truth; right: error (gray, 0-45 deg), red = reflection mixed, blue = specular.
+    let mut rgb = Image::<u8, 3>::new(3 * w, h);
+    let px = rgb.pixels_mut();
+    for y in 0..h {
+        for x in 0..w {
+            let k = y * w + x;
+            let e = shape.normal.pixels()[k];
+            let g = gt.pixels()[k];
+            let enc = |v: f32| ((v * 0.5 + 0.5) * 255.0).clamp(0.0, 255.0) as u8;
+            px[y * 3 * w + x] = e.map(enc);
+            px[y * 3 * w + w + x] = g.map(enc);
+            let dot = (e[0] * g[0] + e[1] * g[1] + e[2] * g[2]).clamp(-1.0, 1.0);
+            let ang = dot.acos().to_degrees();
+            let v = if mask.as_slice()[k] != 0 {
+                (ang / 45.0 * 255.0).min(255.0) as u8
+            } else {
+                0
+            };
+            let fg = shape.foreground.as_slice()[k] != 0;
+            let r = shape.reflection.as_slice()[k];
+            px[y * 3 * w + 2 * w + x] = match (fg, r) {
+                (false, _) => [0, 0, v / 2 + 20],
+                (_, 2) => [v, v, 255],
+                (_, 3) => [255, v, v],
+                _ => [v, v, v],
+            };
+        }
+    }
+    polar_io::write_rgb8_png(dir.join(format!("{name}_{m}.png")), &upscale(&rgb, 3)).unwrap();
+}
+
+fn cue_pictures(dir: &Path, name: &str, obs: &Observation) {
+    let cues = polar_shape::cues::Cues::new(obs, 1.5).unwrap();
+    let g = polar_shape::foreground::edge_strength(&cues).unwrap();
+    let t = polar_imgproc::threshold_otsu(&g).unwrap();
+    let (w, h) = obs.size();
+    let mut rgb = Image::<u8, 3>::new(3 * w, h);
+    let px = rgb.pixels_mut();
+    for y in 0..h {
+        for x in 0..w {
+            let k = y * w + x;
+            let s = (cues.s0n[k].max(0.0).sqrt() * 255.0).min(255.0) as u8;
+            px[y * 3 * w + x] = [s, s, s];
+            let d = (cues.dolp[k] * 4.0 * 255.0).min(255.0) as u8;
+            let a = (cues.aolp[k] / std::f32::consts::PI * 255.0) as u8;
+            px[y * 3 * w + w + x] = [d, a, 255 - a];
+            let e = (g.as_slice()[k] / (2.0 * t) * 255.0).min(255.0) as u8;
+            px[y * 3 * w + 2 * w + x] = if g.as_slice()[k] > t.max(0.15) {
+                [255, e, 0]
+            } else {
+                [e, e, e]
+            };
+        }
+    }
+    polar_io::write_rgb8_png(dir.join(format!("{name}_cues.png")), &upscale(&rgb, 3)).unwrap();
+}
+
+fn upscale(src: &Image<u8, 3>, f: usize) -> Image<u8, 3> {
+    let (w, h) = src.size();
+    let mut out = Image::<u8, 3>::new(w * f, h * f);
+    let px = out.pixels_mut();
+    for y in 0..h * f {
+        for x in 0..w * f {
+            px[y * w * f + x] = src.pixels()[(y / f) * w + x / f];
+        }
+    }
+    out
+}
+
+/// Mean absolute zenith error and mean absolute azimuth error (degrees) in the pixel frames.
+fn split_error(est: &Image<f32, 3>, gt: &Image<f32, 3>, mask: &Gray<u8>, fov: f64) -> (f64, f64) {
+    let cam = CameraModel::Pinhole { fov_x_deg: fov };
+    let (w, h) = est.size();
+    let (mut sz, mut sa, mut n) = (0.0, 0.0, 0.0);
+    for k in 0..w * h {
+        let (e, g) = (est.pixels()[k], gt.pixels()[k]);
+        if mask.as_slice()[k] == 0 || e.iter().all(|v| *v == 0.0) || g.iter().all(|v| *v == 0.0) {
+            continue;
+        }
+        let f = cam.frame(w, h, (k % w) as f64, (k / w) as f64);
+        let v = |a: [f32; 3]| {
+            nalgebra::Vector3::new(f64::from(a[0]), f64::from(a[1]), f64::from(a[2])).normalize()
+        };
+        let (ae, ze) = f.angles(&v(e));
+        let (ag, zg) = f.angles(&v(g));
+        let da = (ae - ag).rem_euclid(std::f64::consts::TAU);
+        sz += (ze - zg).abs().to_degrees();
+        sa += da.min(std::f64::consts::TAU - da).to_degrees();
+        n += 1.0;
+    }
+    (sz / n, sa / n)
+}
+
+/// Times both methods on a sample upscaled (nearest neighbour) to 1024² and 512².
+fn speed(dir: &Path) {
+    let img = polar_io::read_exr(dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS).unwrap();
+    for size in [512usize, 1024] {
+        let (w, h) = img.size();
+        let data = (0..size * size)
+            .flat_map(|k| img.pixels()[((k / size) * h / size) * w + (k % size) * w / size])
+            .collect();
+        let big = polar_image::LinearStokesImage::from_vec(size, size, data).unwrap();
+        let obs = Observation::new(
+            StokesPlanes::from_linear_stokes(&big),
+            CameraModel::Pinhole { fov_x_deg: 35.0 },
+        );
+        for m in [Method::Local, Method::Global] {
+            for integ in [Integrator::FrankotChellappa, Integrator::Poisson] {
+                let opts = ShapeOptions {
+                    method: m,
+                    integrator: integ,
+                    ior: None,
+                };
+                let t = Instant::now();
+                estimate_shape(&obs, &opts).unwrap();
+                println!(
+                    "speed {size}x{size} {m} {integ}: {:.3} s",
+                    t.elapsed().as_secs_f64()
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,257 @@
+//! Shape from polarization: unit camera-frame surface normals, relative depth, a
+//! confidence map and a per-pixel reflection type from one linear-polarization
+//! observation ([`polar_sensor::Observation`]).
+//!
+//! Pipeline ([`estimate_shape`]):
+//! 1. Per-pixel cues ([`cues`]): S0 normalised by [`Observation::s0_scale`], DoLP,
+//!    AoLP, a confidence from the DoLP's signal-to-noise ratio and the validity flags.
+//! 2. Foreground ([`foreground`]): objects are the regions enclosed by strong
+//!    intensity / polarization edges that do not touch the image border.
+//! 3. Candidate normals per pixel from the reflection models of
+//!    [`polar_optics::reflection_dolp`] (diffuse: azimuth = AoLP; specular: AoLP + 90°),
+//!    built in the per-pixel Stokes frame ([`polar_optics::pixel_frame::PixelFrame`]).
+//! 4. Disambiguation: [`Method::Local`] (occluding-boundary prior + convexity +
+//!    smoothness, [`local`]) or [`Method::Global`] (shading and polarization in one
+//!    sparse linear least-squares problem for the height, [`global`]).
+//! 5. Depth from the normals ([`integrate`]): Frankot–Chellappa or a masked Poisson solve.
+//!
+//! Output conventions follow `gt/normal.exr`: `(x, y, z)` in the camera frame (x right,
+//! y up, z toward the camera), `0, 0, 0` where there is no estimate. Depth is relative
+//! (see [`integrate`]): NaN outside the foreground.
+
+pub mod cues;
+pub mod foreground;
+pub mod global;
+pub mod integrate;
+pub mod local;
+pub mod zenith;
+
+#[cfg(test)]
+mod synth;
+#[cfg(test)]
+mod tests;
+
+use std::fmt;
+use std::str::FromStr;
+
+use nalgebra::Vector3;
+use polar_image::{Gray, Image};
+use polar_sensor::Observation;
+use thiserror::Error;
+
+/// The refractive index used when none is given: typical plastics and glass (1.45–1.6);
+/// the zenith error for a true index in 1.3–1.8 stays within a few degrees below ~60°.
+pub const DEFAULT_IOR: f64 = 1.5;
+
+/// Errors of shape from polarization.
+#[derive(Debug, Error, PartialEq)]
+pub enum ShapeError {
+    /// The observation has no pixels.
+    #[error("empty observation ({0}x{1})")]
+    Empty(usize, usize),
+    /// The refractive index is not a finite number above 1.
+    #[error("refractive index {0} is not a finite number > 1")]
+    InvalidIor(f64),
+    /// A method or integrator name that is not known.
+    #[error("unknown {kind} `{name}` (known: {known})")]
+    UnknownName {
+        /// What was being parsed.
+        kind: &'static str,
+        /// The name given.
+        name: String,
+        /// The accepted names.
+        known: &'static str,
+    },
+    /// An image-processing primitive failed.
+    #[error("image processing: {0}")]
+    Imgproc(#[from] polar_imgproc::Error),
+    /// The sparse solver failed.
+    #[error("sparse solver: {0}")]
+    Solver(String),
+}
+
+/// How the azimuth ambiguity is resolved.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Method {
+    /// Occluding-boundary propagation with a convexity prior and smoothness (fast).
+    #[default]
+    Local,
+    /// Height from polarization and shading, one sparse least-squares solve.
+    Global,
+}
+
+impl FromStr for Method {
+    type Err = ShapeError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "local" => Ok(Method::Local),
+            "global" => Ok(Method::Global),
+            _ => Err(ShapeError::UnknownName {
+                kind: "method",
+                name: s.into(),
+                known: "local, global",
+            }),
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Method::Local => "local",
+            Method::Global => "global",
+        })
+    }
+}
+
+/// How depth is obtained from the normals.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Integrator {
+    /// Frankot–Chellappa: least squares in the Fourier domain over the whole image.
+    FrankotChellappa,
+    /// Weighted least squares (screened Poisson) over the foreground only.
+    #[default]
+    Poisson,
+}
+
+impl FromStr for Integrator {
+    type Err = ShapeError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "fc" => Ok(Integrator::FrankotChellappa),
+            "poisson" => Ok(Integrator::Poisson),
+            _ => Err(ShapeError::UnknownName {
+                kind: "integrator",
+                name: s.into(),
+                known: "fc, poisson",
+            }),
+        }
+    }
+}
+
+impl fmt::Display for Integrator {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Integrator::FrankotChellappa => "fc",
+            Integrator::Poisson => "poisson",
+        })
+    }
+}
+
+/// Options of [`estimate_shape`]; the default is local, Poisson, index [`DEFAULT_IOR`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeOptions {
+    /// Disambiguation method.
+    pub method: Method,
+    /// Depth integrator of the local method (the global method's depth is its own
+    /// least-squares solution, so it ignores this).
+    pub integrator: Integrator,
+    /// Relative refractive index of the objects; [`DEFAULT_IOR`] when `None`.
+    pub ior: Option<f64>,
+}
+
+impl Default for ShapeOptions {
+    fn default() -> Self {
+        Self {
+            method: Method::Local,
+            integrator: Integrator::Poisson,
+            ior: None,
+        }
+    }
+}
+
+/// The reflection that explains a pixel's polarization.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum ReflectionType {
+    /// No estimate (background, invalid pixel).
+    None = 0,
+    /// Diffuse: AoLP parallel to the plane of incidence.
+    Diffuse = 1,
+    /// Specular: AoLP perpendicular to the plane of incidence.
+    Specular = 2,
+    /// Both contribute comparably; the polarization is not explained by one model alone.
+    Mixed = 3,
+}
+
+/// Result of [`estimate_shape`].
+#[derive(Clone, Debug)]
+pub struct Shape {
+    /// Unit camera-frame normals (R, G, B = x, y, z; z > 0 faces the camera), `0,0,0`
+    /// where there is no estimate.
+    pub normal: Image<f32, 3>,
+    /// Relative depth (larger = farther), NaN outside the foreground.
+    pub depth: Gray<f32>,
+    /// Confidence in `[0, 1]` of each normal (0 where there is none).
+    pub confidence: Gray<f32>,
+    /// [`ReflectionType`] as `u8` per pixel.
+    pub reflection: Gray<u8>,
+    /// 255 on the estimated objects, 0 elsewhere.
+    pub foreground: Gray<u8>,
+    /// The refractive index used.
+    pub ior: f64,
+}
+
+/// Normals, depth, confidence and reflection types of one observation.
+///
+/// Errors: an empty observation, an invalid `opts.ior`, or a solver failure. An all-dark
+/// or all-invalid frame is not an error: it gives no foreground, zero normals and NaN depth.
+pub fn estimate_shape(obs: &Observation, opts: &ShapeOptions) -> Result<Shape, ShapeError> {
+    let (w, h) = obs.size();
+    if w == 0 || h == 0 {
+        return Err(ShapeError::Empty(w, h));
+    }
+    let ior = opts.ior.unwrap_or(DEFAULT_IOR);
+    if !(ior.is_finite() && ior > 1.0) {
+        return Err(ShapeError::InvalidIor(ior));
+    }
+    let cues = cues::Cues::new(obs, ior)?;
+    let fg = foreground::foreground(&cues)?;
+    let est = match opts.method {
+        Method::Local => local::disambiguate(&cues, &fg)?,
+        Method::Global => global::solve(&cues, &fg, opts.integrator)?,
+    };
+    let depth = match (opts.method, &est.depth) {
+        (Method::Global, Some(d)) => d.clone(),
+        _ => integrate::depth_from_normals(
+            &est.normals,
+            &est.confidence,
+            &fg,
+            opts.integrator,
+            w,
+            h,
+        )?,
+    };
+    Ok(Shape {
+        normal: normal_image(w, h, &est.normals),
+        depth,
+        confidence: Gray::from_vec(w, h, est.confidence.clone()).expect("sized"),
+        reflection: Gray::from_vec(w, h, est.reflection.iter().map(|&r| r as u8).collect())
+            .expect("sized"),
+        foreground: Gray::from_vec(w, h, fg.iter().map(|&f| if f { 255 } else { 0 }).collect())
+            .expect("sized"),
+        ior,
+    })
+}
+
+/// Per-pixel result of a disambiguation method.
+#[derive(Clone, Debug)]
+pub struct Estimate {
+    /// Unit normals (zero vector where none).
+    pub normals: Vec<Vector3<f64>>,
+    /// Confidence in `[0, 1]`.
+    pub confidence: Vec<f32>,
+    /// Reflection type per pixel.
+    pub reflection: Vec<ReflectionType>,
+    /// Depth, when the method produces it directly (the global method).
+    pub depth: Option<Gray<f32>>,
+}
+
+/// Interleaved `f32` normal image from per-pixel vectors.
+fn normal_image(w: usize, h: usize, normals: &[Vector3<f64>]) -> Image<f32, 3> {
+    let data = normals
+        .iter()
+        .flat_map(|n| [n.x as f32, n.y as f32, n.z as f32])
+        .collect();
+    Image::from_vec(w, h, data).expect("sized")
+}

@@ -1,0 +1,366 @@
+//! The local method: the azimuth ambiguity resolved by propagation from the occluding
+//! boundary with a convexity prior and smoothness (after Atkinson & Hancock 2006 and
+//! Miyazaki et al. 2003).
+//!
+//! 1. Prior ([`boundary_prior`]): at the silhouette of a smooth object the normal lies in
+//!    the image plane and points away from the object; for a convex object it turns
+//!    smoothly toward the viewer inside. With `D` the distance to the nearest background
+//!    pixel and `R` its maximum over the object's connected component, the prior normal
+//!    has azimuth `−∇D` (smoothed) and zenith `asin(1 − D/R)` (exact for a sphere).
+//! 2. Candidates per pixel: diffuse `(AoLP, θ_d)`, `(AoLP + π, θ_d)`; specular
+//!    `(AoLP ± π/2, θ_s)` with both specular zeniths, in the per-pixel Stokes frame.
+//! 3. Iterations: each pixel takes the candidate closest to a reference field; the
+//!    field is the confidence-weighted Gaussian average of the chosen normals plus the
+//!    prior. Pixels with DoLP beyond the diffuse model or highlights
+//!    ([`Cues::surely_specular`]) only get specular candidates. Elsewhere a specular
+//!    candidate costs [`MIXED_PENALTY`]; when one still wins, the pixel is
+//!    [`ReflectionType::Mixed`]: its azimuth is the specular one and, since the DoLP of
+//!    two cancelling components says little about the zenith, its zenith is the field's.
+//! 4. Output: `normalize(c n + (1 − c) field)` with `c` the polarization confidence, so
+//!    pixels without measurable polarization take their neighbours' shape.
+//!
+//! Concave regions are recovered only where smoothness carries the DoLP/AoLP evidence
+//! against the convex prior (the prior is weak away from the contour).
+
+use nalgebra::Vector3;
+use polar_image::Gray;
+use polar_imgproc::{Connectivity, gaussian_blur, label};
+use rayon::prelude::*;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use crate::cues::{Cues, image_direction_angle};
+use crate::{Estimate, ReflectionType, ShapeError};
+
+/// Cost of explaining a pixel without specular evidence by the specular model.
+pub const MIXED_PENALTY: f64 = 0.05;
+/// Gaussian sigma (pixels) of the smoothness field.
+const FIELD_SIGMA: f64 = 1.5;
+/// Weight of the boundary prior in the field.
+const PRIOR_WEIGHT: f64 = 0.5;
+/// Iterations of candidate choice and field update.
+const ITERATIONS: usize = 6;
+
+/// The prior of step 1: a unit normal and a weight per pixel.
+pub struct Prior {
+    /// Prior normals (camera frame).
+    pub normal: Vec<Vector3<f64>>,
+    /// Prior weight in `[0, 1]` (0 off the foreground or without any contour).
+    pub weight: Vec<f64>,
+}
+
+/// Disambiguated normals of the foreground pixels.
+pub fn disambiguate(cues: &Cues, fg: &[bool]) -> Result<Estimate, ShapeError> {
+    let n = cues.len();
+    let prior = boundary_prior(cues, fg)?;
+    let mut field = prior.normal.clone();
+    let mut chosen: Vec<(Vector3<f64>, ReflectionType, f64)> = Vec::new();
+    for _ in 0..ITERATIONS {
+        chosen = (0..n)
+            .into_par_iter()
+            .map(|k| {
+                if fg[k] {
+                    choose(cues, k, &field[k])
+                } else {
+                    (Vector3::zeros(), ReflectionType::None, 0.0)
+                }
+            })
+            .collect();
+        field = smooth_field(cues, fg, &chosen, &prior)?;
+    }
+    let out: Vec<(Vector3<f64>, f32)> = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            if !fg[k] {
+                return (Vector3::zeros(), 0.0);
+            }
+            let c = f64::from(cues.confidence[k]);
+            let (nc, kind, agree) = chosen[k];
+            let m = (nc * c + field[k] * (1.0 - c))
+                .try_normalize(1e-12)
+                .unwrap_or(field[k]);
+            let penalty = if kind == ReflectionType::Mixed {
+                0.5
+            } else {
+                1.0
+            };
+            (m, (c * agree.max(0.0) * penalty) as f32)
+        })
+        .collect();
+    Ok(Estimate {
+        normals: out.iter().map(|v| v.0).collect(),
+        confidence: out.iter().map(|v| v.1).collect(),
+        reflection: chosen.iter().map(|v| v.1).collect(),
+        depth: None,
+    })
+}
+
+/// The candidate of pixel `k` closest to `reference` (largest `n · reference` minus the
+/// type's cost): `(normal, type, n · reference)`. Diffuse candidates take the diffuse
+/// model's zenith, specular ones both specular branches, mixed ones the reference's
+/// zenith (module doc).
+pub fn choose(
+    cues: &Cues,
+    k: usize,
+    reference: &Vector3<f64>,
+) -> (Vector3<f64>, ReflectionType, f64) {
+    let f = cues.frame(k);
+    if !cues.valid[k] {
+        return (*reference, ReflectionType::None, 1.0);
+    }
+    let alpha = f64::from(cues.aolp[k]);
+    let dolp = f64::from(cues.dolp[k]);
+    let mut best = (*reference, ReflectionType::None, f64::NEG_INFINITY);
+    let mut consider = |n: Vector3<f64>, kind: ReflectionType, cost: f64| {
+        let score = n.dot(reference) - cost;
+        if score > best.2 {
+            best = (n, kind, score);
+        }
+    };
+    if cues.surely_specular(k) {
+        let (lo, hi) = cues.models.specular(dolp);
+        for az in [alpha + FRAC_PI_2, alpha - FRAC_PI_2] {
+            for z in [lo, hi] {
+                consider(f.normal(az, z), ReflectionType::Specular, 0.0);
+            }
+        }
+    } else {
+        let zd = cues.models.diffuse(dolp);
+        for az in [alpha, alpha + PI] {
+            consider(f.normal(az, zd), ReflectionType::Diffuse, 0.0);
+        }
+        let (_, ref_zenith) = f.angles(reference);
+        for az in [alpha + FRAC_PI_2, alpha - FRAC_PI_2] {
+            consider(
+                f.normal(az, ref_zenith),
+                ReflectionType::Mixed,
+                MIXED_PENALTY,
+            );
+        }
+    }
+    let (n, kind, _) = best;
+    (n, kind, n.dot(reference))
+}
+
+/// Confidence-weighted Gaussian average of the chosen normals plus the prior, normalised.
+fn smooth_field(
+    cues: &Cues,
+    fg: &[bool],
+    chosen: &[(Vector3<f64>, ReflectionType, f64)],
+    prior: &Prior,
+) -> Result<Vec<Vector3<f64>>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let weight = |k: usize| {
+        if fg[k] {
+            0.05 + f64::from(cues.confidence[k])
+        } else {
+            0.0
+        }
+    };
+    let mut planes = Vec::with_capacity(3);
+    for c in 0..3 {
+        let src = Gray::from_vec(
+            w,
+            h,
+            (0..w * h)
+                .map(|k| (chosen[k].0[c] * weight(k)) as f32)
+                .collect(),
+        )
+        .expect("sized");
+        planes.push(blur(&src)?);
+    }
+    Ok((0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            if !fg[k] {
+                return Vector3::zeros();
+            }
+            let avg = Vector3::new(
+                f64::from(planes[0].as_slice()[k]),
+                f64::from(planes[1].as_slice()[k]),
+                f64::from(planes[2].as_slice()[k]),
+            );
+            let v = avg + prior.normal[k] * (PRIOR_WEIGHT * prior.weight[k]);
+            v.try_normalize(1e-12).unwrap_or(prior.normal[k])
+        })
+        .collect())
+}
+
+/// Gaussian blur with the field's sigma.
+fn blur(src: &Gray<f32>) -> Result<Gray<f32>, ShapeError> {
+    let mut dst = Gray::new(src.width(), src.height());
+    gaussian_blur(src, &mut dst, 0, FIELD_SIGMA)?;
+    Ok(dst)
+}
+
+/// The occluding-boundary prior of step 1 (module doc).
+pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let n = w * h;
+    let dist = distance_to_background(fg, w, h);
+    if dist.iter().all(|d| !d.is_finite()) {
+        // No contour: the prior faces the camera and carries no weight.
+        let normal = (0..n).map(|k| -cues.frame(k).d).collect();
+        return Ok(Prior {
+            normal,
+            weight: vec![0.0; n],
+        });
+    }
+    let radius = component_max(fg, &dist, w, h)?;
+    let smooth = {
+        let src =
+            Gray::from_vec(w, h, dist.iter().map(|&d| d.min(1e6) as f32).collect()).expect("sized");
+        let mut dst = Gray::new(w, h);
+        gaussian_blur(&src, &mut dst, 0, 1.0)?;
+        dst
+    };
+    let s = smooth.as_slice();
+    let at = |x: usize, y: usize| f64::from(s[y * w + x]);
+    let out: Vec<(Vector3<f64>, f64)> = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            let f = cues.frame(k);
+            if !fg[k] {
+                return (-f.d, 0.0);
+            }
+            let (x, y) = (k % w, k / w);
+            let gx = at((x + 1).min(w - 1), y) - at(x.saturating_sub(1), y);
+            let gy = at(x, (y + 1).min(h - 1)) - at(x, y.saturating_sub(1));
+            let r = radius[k].max(1.0);
+            let sin_z = (1.0 - (dist[k] - 0.5).max(0.0) / r).clamp(0.0, 1.0);
+            if gx.hypot(gy) < 1e-6 {
+                return (-f.d, 0.0);
+            }
+            let az = image_direction_angle(&f, -gx, -gy);
+            (f.normal(az, sin_z.asin()), sin_z * sin_z)
+        })
+        .collect();
+    Ok(Prior {
+        normal: out.iter().map(|v| v.0).collect(),
+        weight: out.iter().map(|v| v.1).collect(),
+    })
+}
+
+/// Per foreground pixel, the largest distance in its 8-connected component.
+fn component_max(fg: &[bool], dist: &[f64], w: usize, h: usize) -> Result<Vec<f64>, ShapeError> {
+    let mask = Gray::from_vec(w, h, fg.iter().map(|&f| u8::from(f)).collect()).expect("sized");
+    let mut labels = Gray::new(w, h);
+    let count = label(&mask, &mut labels, Connectivity::Eight)?;
+    let mut max = vec![0.0f64; count + 1];
+    let l = labels.as_slice();
+    for k in 0..w * h {
+        if fg[k] && dist[k].is_finite() {
+            let m = &mut max[l[k] as usize];
+            *m = m.max(dist[k]);
+        }
+    }
+    Ok(l.iter().map(|&c| max[c as usize]).collect())
+}
+
+/// Euclidean distance (pixels) from each pixel to the nearest non-foreground pixel
+/// (Felzenszwalb & Huttenlocher 2012, two passes of the 1-D squared transform); 0 on the
+/// background, infinite everywhere when there is no background pixel. Pixels outside
+/// the image are not background: a border cut is not an occluding contour.
+pub fn distance_to_background(fg: &[bool], w: usize, h: usize) -> Vec<f64> {
+    let inf = f64::INFINITY;
+    let mut d: Vec<f64> = fg.iter().map(|&f| if f { inf } else { 0.0 }).collect();
+    if d.iter().all(|v| v.is_infinite()) {
+        return d;
+    }
+    let mut buf = Vec::new();
+    for x in 0..w {
+        let col: Vec<f64> = (0..h).map(|y| d[y * w + x]).collect();
+        edt_1d(&col, &mut buf);
+        for y in 0..h {
+            d[y * w + x] = buf[y];
+        }
+    }
+    for y in 0..h {
+        let row = d[y * w..(y + 1) * w].to_vec();
+        edt_1d(&row, &mut buf);
+        d[y * w..(y + 1) * w].copy_from_slice(&buf);
+    }
+    d.iter().map(|v| v.sqrt()).collect()
+}
+
+/// 1-D squared distance transform of `f` (lower envelope of parabolas) into `out`.
+fn edt_1d(f: &[f64], out: &mut Vec<f64>) {
+    let n = f.len();
+    out.clear();
+    out.resize(n, f64::INFINITY);
+    let mut v = vec![0usize; n];
+    let mut z = vec![0.0f64; n + 1];
+    let mut k = 0usize;
+    let mut started = false;
+    for q in 0..n {
+        if f[q].is_infinite() {
+            continue;
+        }
+        if !started {
+            v[0] = q;
+            z[0] = f64::NEG_INFINITY;
+            z[1] = f64::INFINITY;
+            started = true;
+            continue;
+        }
+        loop {
+            let p = v[k];
+            let s =
+                ((f[q] + (q * q) as f64) - (f[p] + (p * p) as f64)) / (2.0 * (q as f64 - p as f64));
+            if s <= z[k] && k > 0 {
+                k -= 1;
+                continue;
+            }
+            if s <= z[k] {
+                // k == 0 and the new parabola dominates everywhere.
+                v[0] = q;
+                z[0] = f64::NEG_INFINITY;
+                z[1] = f64::INFINITY;
+                break;
+            }
+            k += 1;
+            v[k] = q;
+            z[k] = s;
+            z[k + 1] = f64::INFINITY;
+            break;
+        }
+    }
+    if !started {
+        return;
+    }
+    k = 0;
+    for (q, o) in out.iter_mut().enumerate() {
+        while z[k + 1] < q as f64 {
+            k += 1;
+        }
+        let p = v[k];
+        let dq = q as f64 - p as f64;
+        *o = dq * dq + f[p];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distance_transform_matches_brute_force() {
+        let (w, h) = (9, 7);
+        let fg: Vec<bool> = (0..w * h)
+            .map(|k| !matches!((k % w, k / w), (0, 0) | (6, 4) | (3, 6)))
+            .collect();
+        let d = distance_to_background(&fg, w, h);
+        for (k, dk) in d.iter().enumerate() {
+            let (x, y) = ((k % w) as f64, (k / w) as f64);
+            let brute = [(0.0, 0.0), (6.0, 4.0), (3.0, 6.0)]
+                .iter()
+                .map(|(a, b)| (x - a).hypot(y - b))
+                .fold(f64::INFINITY, f64::min);
+            assert!((dk - brute).abs() < 1e-12, "{k}: {dk} {brute}");
+        }
+        assert!(
+            distance_to_background(&[true; 4], 2, 2)
+                .iter()
+                .all(|v| v.is_infinite())
+        );
+    }
+}

@@ -1,0 +1,142 @@
+//! Cue maps for transparent objects and the combined score.
+//!
+//! - `dolp`: DoLP of the normalised Stokes vector `(S1/S0, S2/S0)`, median-filtered
+//!   ([`MEDIAN`]², against isolated outliers) and averaged over a [`WINDOW`]² window of
+//!   valid pixels (scale-free).
+//! - `coherence`: that DoLP over the window's mean per-pixel DoLP, in `[0, 1]`: `1` where
+//!   the AoLP is the same over the window (light polarized by a surface), near `0` where
+//!   the per-pixel polarization points anywhere (noise; demosaicing artefacts at texture
+//!   edges, whose sign flips from one side of the edge to the other).
+//! - The score is `e / (e + HALF_DOLP)` with `e = dolp · coherence`, in `[0, 1)`.
+
+use polar_image::Gray;
+use polar_imgproc::{Border, box_filter, median_blur};
+use polar_sensor::Observation;
+
+use crate::TransparencyError;
+
+/// Side of the averaging window (pixels, odd).
+pub const WINDOW: usize = 5;
+/// Coherent DoLP at which the score is one half.
+pub const HALF_DOLP: f32 = 0.05;
+
+/// The cue planes of one observation.
+#[derive(Clone, Debug)]
+pub struct CueMaps {
+    /// Windowed DoLP in `[0, 1]` (0 where no valid pixel is in the window).
+    pub dolp: Vec<f32>,
+    /// Coherence of the polarization over the window, in `[0, 1]`.
+    pub coherence: Vec<f32>,
+    /// Windowed AoLP in `[0, π)`.
+    pub aolp: Vec<f32>,
+}
+
+/// Windowed mean of `v` where `valid`, 0 where the window holds no valid pixel.
+fn masked_mean(
+    v: &[f32],
+    valid: &[f32],
+    mean_w: &[f32],
+    w: usize,
+    h: usize,
+) -> Result<Vec<f32>, TransparencyError> {
+    let src = Gray::from_vec(w, h, v.iter().zip(valid).map(|(&a, &m)| a * m).collect())
+        .expect("size of the planes");
+    let mut dst = Gray::new(w, h);
+    box_filter(&src, &mut dst, WINDOW, WINDOW, Border::Reflect101)?;
+    Ok(dst
+        .as_slice()
+        .iter()
+        .zip(mean_w)
+        .map(|(&s, &m)| if m > 0.0 { s / m } else { 0.0 })
+        .collect())
+}
+
+/// Side of the median filter applied to `S1/S0` and `S2/S0` before averaging.
+pub const MEDIAN: usize = 5;
+
+/// [`MEDIAN`]² median of a plane: removes isolated outliers (hot pixels, Monte Carlo
+/// fireflies, demosaicing spikes at single bright pixels) that a mean would spread.
+fn median(v: Vec<f32>, w: usize, h: usize) -> Result<Vec<f32>, TransparencyError> {
+    let k = MEDIAN;
+    if w < 2 || h < 2 {
+        return Ok(v);
+    }
+    let src = Gray::from_vec(w, h, v).expect("size of the planes");
+    let mut dst = Gray::new(w, h);
+    median_blur(&src, &mut dst, k)?;
+    Ok(dst.into_vec())
+}
+
+/// The cue maps of `obs`.
+pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
+    let (w, h) = obs.size();
+    let p = &obs.planes;
+    let (s0, s1, s2) = (p.s0.as_slice(), p.s1.as_slice(), p.s2.as_slice());
+    let n = w * h;
+    let valid: Vec<f32> = (0..n)
+        .map(|k| {
+            let ok = obs.is_valid(k)
+                && s0[k] > 0.0
+                && [s0[k], s1[k], s2[k]].iter().all(|v| v.is_finite());
+            f32::from(u8::from(ok))
+        })
+        .collect();
+    // Stokes divided by S0 per pixel: the window then averages polarization states with
+    // equal weight, whatever the texture's brightness, and the scale drops out.
+    let q: Vec<f32> = (0..n)
+        .map(|k| if valid[k] > 0.0 { s1[k] / s0[k] } else { 0.0 })
+        .collect();
+    let u: Vec<f32> = (0..n)
+        .map(|k| if valid[k] > 0.0 { s2[k] / s0[k] } else { 0.0 })
+        .collect();
+    let (q, u) = (median(q, w, h)?, median(u, w, h)?);
+    let d: Vec<f32> = q
+        .iter()
+        .zip(&u)
+        .map(|(a, b)| a.hypot(*b).min(1.0))
+        .collect();
+    let wsrc = Gray::from_vec(w, h, valid.clone()).expect("size of the planes");
+    let mut wmean = Gray::new(w, h);
+    box_filter(&wsrc, &mut wmean, WINDOW, WINDOW, Border::Reflect101)?;
+    let mw = wmean.as_slice();
+    let (qm, um, dm) = (
+        masked_mean(&q, &valid, mw, w, h)?,
+        masked_mean(&u, &valid, mw, w, h)?,
+        masked_mean(&d, &valid, mw, w, h)?,
+    );
+    let mut dolp = vec![0.0; n];
+    let mut coherence = vec![0.0; n];
+    let mut aolp = vec![0.0; n];
+    for k in 0..n {
+        let r = qm[k].hypot(um[k]).min(1.0);
+        dolp[k] = if r.is_finite() { r } else { 0.0 };
+        coherence[k] = if dm[k] > 0.0 {
+            (dolp[k] / dm[k]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let a = (0.5 * um[k].atan2(qm[k])).rem_euclid(std::f32::consts::PI);
+        aolp[k] = if a.is_finite() { a } else { 0.0 };
+    }
+    Ok(CueMaps {
+        dolp,
+        coherence,
+        aolp,
+    })
+}
+
+/// The per-pixel transparency score in `[0, 1)` (see the module docs).
+pub fn score(obs: &Observation) -> Result<Gray<f32>, TransparencyError> {
+    let (w, h) = obs.size();
+    let c = cue_maps(obs)?;
+    let s = c
+        .dolp
+        .iter()
+        .zip(&c.coherence)
+        .map(|(&d, &k)| {
+            let e = d * k;
+            e / (e + HALF_DOLP)
+        })
+        .collect();
+    Ok(Gray::from_vec(w, h, s).expect("size of the observation"))
+}

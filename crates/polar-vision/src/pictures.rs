@@ -1,0 +1,106 @@
+//! 8-bit pictures of the task outputs, for people (written under `pictures/`).
+
+use polar_image::{Gray, Image};
+use polar_sensor::picture::{colormap, quantile};
+
+/// Normals as colours: `(n + 1) / 2` per axis (x red, y green, z blue); black where none.
+pub fn normal_picture(normals: &Image<f32, 3>) -> Image<u8, 3> {
+    map_rgb(normals.size(), normals.pixels(), |n| {
+        if n.iter().all(|&v| v == 0.0) || n.iter().any(|v| !v.is_finite()) {
+            [0, 0, 0]
+        } else {
+            n.map(|v| ((v.clamp(-1.0, 1.0) * 0.5 + 0.5) * 255.0).round() as u8)
+        }
+    })
+}
+
+/// A label image through a palette (labels past its end are white).
+pub fn label_picture(labels: &Gray<u8>, palette: &[[u8; 3]]) -> Image<u8, 3> {
+    map_rgb(labels.size(), labels.pixels(), |[l]| {
+        palette.get(usize::from(*l)).copied().unwrap_or([255; 3])
+    })
+}
+
+/// Reflection types: none black, diffuse blue, specular red, mixed yellow.
+pub const REFLECTION_PALETTE: [[u8; 3]; 4] =
+    [[0, 0, 0], [40, 90, 230], [230, 40, 40], [230, 200, 40]];
+
+/// Material labels: background dark grey, dielectric orange, metal steel blue, transparent cyan.
+pub const MATERIAL_PALETTE: [[u8; 3]; 4] = [
+    [40, 40, 40],
+    [230, 140, 40],
+    [110, 140, 190],
+    [60, 220, 230],
+];
+
+/// S0 as grey (0 to its 99.5th percentile) with `mask` (non-zero) tinted red.
+pub fn overlay_picture(s0: &Gray<f32>, mask: &Gray<u8>) -> Image<u8, 3> {
+    let top = quantile(s0, 0.995).filter(|&q| q > 0.0).unwrap_or(1.0);
+    let grey = |v: f32| (v / top).clamp(0.0, 1.0) * 255.0;
+    let data: Vec<[u8; 3]> = s0
+        .as_slice()
+        .iter()
+        .zip(mask.as_slice())
+        .map(|(&v, &m)| {
+            let g = if v.is_finite() { grey(v) } else { 0.0 };
+            if m != 0 {
+                [(0.5 * g + 127.0) as u8, (0.5 * g) as u8, (0.5 * g) as u8]
+            } else {
+                [g as u8; 3]
+            }
+        })
+        .collect();
+    from_pixels(s0.size(), data)
+}
+
+/// Images side by side on one viridis scale from 0 to the first image's 99.5th percentile
+/// (so a dehazed image is seen against its hazy input), then `extra` on its own 0..1 scale.
+pub fn side_by_side(same_scale: &[&Gray<f32>], extra: Option<&Gray<f32>>) -> Image<u8, 3> {
+    let top = same_scale
+        .first()
+        .and_then(|g| quantile(g, 0.995))
+        .filter(|&q| q > 0.0)
+        .unwrap_or(1.0);
+    let mut parts: Vec<Image<u8, 3>> = same_scale.iter().map(|g| colormap(g, 0.0, top)).collect();
+    parts.extend(extra.map(|g| colormap(g, 0.0, 1.0)));
+    let (w, h) = parts.first().map_or((0, 0), |p| p.size());
+    let mut data = Vec::with_capacity(w * h * parts.len());
+    for y in 0..h {
+        for p in &parts {
+            data.extend_from_slice(&p.pixels()[y * w..(y + 1) * w]);
+        }
+    }
+    from_pixels((w * parts.len(), h), data)
+}
+
+fn map_rgb<T, const C: usize>(
+    size: (usize, usize),
+    px: &[[T; C]],
+    f: impl Fn(&[T; C]) -> [u8; 3],
+) -> Image<u8, 3> {
+    from_pixels(size, px.iter().map(f).collect())
+}
+
+fn from_pixels((w, h): (usize, usize), px: Vec<[u8; 3]>) -> Image<u8, 3> {
+    Image::from_vec(w, h, px.into_flattened()).expect("one RGB triple per pixel")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normals_map_to_colours_and_missing_ones_to_black() {
+        let n = Image::<f32, 3>::from_vec(2, 1, vec![0.0, 0.0, 1.0, 0.0, 0.0, 0.0]).unwrap();
+        let p = normal_picture(&n);
+        assert_eq!(p.pixels(), &[[128, 128, 255], [0, 0, 0]]);
+    }
+
+    #[test]
+    fn side_by_side_is_as_wide_as_its_parts() {
+        let a = Gray::from_vec(3, 2, vec![0.0f32, 1.0, 2.0, 3.0, 4.0, 5.0]).unwrap();
+        let p = side_by_side(&[&a, &a], Some(&a));
+        assert_eq!(p.size(), (9, 2));
+        assert_eq!(p.pixel(1, 1), p.pixel(4, 1));
+    }
+}

@@ -1,0 +1,45 @@
+//! `material`: material classification (polar-material) -> material.png,
+//! material_confidence.exr and a colour picture; material metrics.
+
+use polar_eval::material_metrics;
+use polar_io::Y_CHANNEL;
+use polar_io::files::vision;
+use polar_material::{Classifier, MaterialOptions, classify};
+
+use super::{Context, Failure, Outcome, io, picture_path, to_json};
+use crate::pictures::{MATERIAL_PALETTE, label_picture};
+use crate::task_options::TaskArgs;
+
+/// Runs the task with the normals and transparency mask of earlier tasks, where they ran.
+pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> {
+    let map = classify(
+        ctx.obs,
+        ctx.normals.as_ref(),
+        None,
+        ctx.transparent.as_ref(),
+        &Classifier::Physics,
+        &MaterialOptions::default(),
+    )
+    .map_err(|e| Failure::CannotRun(e.to_string()))?;
+    let out = ctx.out;
+    polar_io::write_gray8_png(out.join(vision::MATERIAL), &map.labels).map_err(io)?;
+    polar_io::write_exr(
+        out.join(vision::MATERIAL_CONFIDENCE),
+        &map.confidence,
+        Y_CHANNEL,
+    )
+    .map_err(io)?;
+    let picture = label_picture(&map.labels, &MATERIAL_PALETTE);
+    polar_io::write_rgb8_png(picture_path(out, "material.png"), &picture).map_err(io)?;
+    let mut outcome = Outcome::default();
+    if ctx.normals.is_none() {
+        outcome
+            .messages
+            .push("without sfp's normals: azimuths from the silhouettes".into());
+    }
+    if let Some(gt) = &ctx.gt.material {
+        let m = material_metrics(&map.labels, gt).map_err(|e| Failure::CannotRun(e.to_string()))?;
+        outcome.metrics = Some(to_json(&m)?);
+    }
+    Ok(outcome)
+}

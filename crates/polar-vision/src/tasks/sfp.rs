@@ -1,0 +1,63 @@
+//! `sfp`: shape from polarization (polar-shape) -> normal.exr, depth.exr,
+//! normal_confidence.exr, reflection.png and pictures; normal and depth metrics.
+
+use polar_eval::normal_metrics;
+use polar_io::files::vision;
+use polar_io::{RGB_CHANNELS, Y_CHANNEL};
+use polar_shape::{Shape, ShapeOptions, estimate_shape};
+
+use super::{Context, Failure, Outcome, io, object_mask, picture_path, to_json};
+use crate::pictures::{REFLECTION_PALETTE, label_picture, normal_picture};
+use crate::task_options::TaskArgs;
+
+/// Names of the reflection types, index = value of reflection.png.
+const REFLECTION_NAMES: [&str; 4] = ["none", "diffuse", "specular", "mixed"];
+
+/// Runs the task; leaves the normals for `material`.
+pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
+    let opts = ShapeOptions {
+        method: args.sfp_method,
+        integrator: args.integrator,
+        ior: args.ior,
+    };
+    let shape = estimate_shape(ctx.obs, &opts).map_err(|e| Failure::CannotRun(e.to_string()))?;
+    write(ctx, &shape)?;
+    let mut outcome = Outcome::default();
+    let objects = shape
+        .foreground
+        .as_slice()
+        .iter()
+        .filter(|&&v| v != 0)
+        .count();
+    outcome.messages.push(format!(
+        "{} with index {:.3}; {objects} pixels on objects",
+        opts.method, shape.ior
+    ));
+    if let (Some(gt_n), Some(objects)) = (&ctx.gt.normal, object_mask(ctx.gt)) {
+        let types = Some((&shape.reflection, REFLECTION_NAMES.as_slice()));
+        let depth = ctx.gt.depth.as_ref().map(|d| (&shape.depth, d));
+        let m = normal_metrics(&shape.normal, gt_n, &objects, types, depth)
+            .map_err(|e| Failure::CannotRun(e.to_string()))?;
+        outcome.metrics = Some(to_json(&serde_json::json!({ "normal": m }))?);
+    }
+    ctx.normals = Some(shape.normal);
+    Ok(outcome)
+}
+
+fn write(ctx: &Context<'_>, s: &Shape) -> Result<(), Failure> {
+    let out = ctx.out;
+    polar_io::write_exr(out.join(vision::NORMAL), &s.normal, RGB_CHANNELS).map_err(io)?;
+    polar_io::write_exr(out.join(vision::DEPTH), &s.depth, Y_CHANNEL).map_err(io)?;
+    polar_io::write_exr(
+        out.join(vision::NORMAL_CONFIDENCE),
+        &s.confidence,
+        Y_CHANNEL,
+    )
+    .map_err(io)?;
+    polar_io::write_gray8_png(out.join(vision::REFLECTION), &s.reflection).map_err(io)?;
+    polar_io::write_rgb8_png(picture_path(out, "normal.png"), &normal_picture(&s.normal))
+        .map_err(io)?;
+    let types = label_picture(&s.reflection, &REFLECTION_PALETTE);
+    polar_io::write_rgb8_png(picture_path(out, "reflection.png"), &types).map_err(io)?;
+    Ok(())
+}

@@ -1,0 +1,42 @@
+//! `transparent`: transparent-object detection (polar-transparency) -> transparent.png,
+//! transparent_score.exr and an overlay picture; mask metrics with the false positives on
+//! opaque objects.
+
+use polar_eval::mask_metrics;
+use polar_image::Gray;
+use polar_io::Y_CHANNEL;
+use polar_io::files::vision;
+use polar_transparency::{TransparencyOptions, detect};
+
+use super::{Context, Failure, Outcome, io, picture_path, to_json};
+use crate::pictures::overlay_picture;
+use crate::task_options::TaskArgs;
+
+/// Runs the task; leaves the mask for `material`.
+pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> {
+    let map = detect(ctx.obs, &TransparencyOptions::default())
+        .map_err(|e| Failure::CannotRun(e.to_string()))?;
+    let out = ctx.out;
+    polar_io::write_gray8_png(out.join(vision::TRANSPARENT), &map.mask).map_err(io)?;
+    polar_io::write_exr(out.join(vision::TRANSPARENT_SCORE), &map.score, Y_CHANNEL).map_err(io)?;
+    let picture = overlay_picture(&ctx.obs.planes.s0, &map.mask);
+    polar_io::write_rgb8_png(picture_path(out, "transparent.png"), &picture).map_err(io)?;
+    let mut outcome = Outcome::default();
+    if let Some(gt) = &ctx.gt.transparent {
+        let opaque = ctx.gt.material.as_ref().map(opaque_objects);
+        let m = mask_metrics(&map.mask, gt, opaque.as_ref())
+            .map_err(|e| Failure::CannotRun(e.to_string()))?;
+        outcome.metrics = Some(to_json(&m)?);
+    }
+    ctx.transparent = Some(map.mask);
+    Ok(outcome)
+}
+
+/// Opaque objects (dielectric or metal labels): where a transparency mask must stay off.
+fn opaque_objects(labels: &Gray<u8>) -> Gray<u8> {
+    let mut m = labels.clone();
+    for v in m.as_mut_slice() {
+        *v = u8::from(*v == polar_io::material::DIELECTRIC || *v == polar_io::material::METAL);
+    }
+    m
+}

@@ -1,0 +1,112 @@
+//! End to end: the `standard` suite at its `ci` size (made here by the dataset generator),
+//! every task through the vision CLI's `eval`, the accuracy targets of the task issues
+//! asserted with margins for the small, 8-spp `ci` images, and determinism across jobs.
+
+mod common;
+
+// The ci samples are seeded, so these figures are fixed for a given code version; each floor
+// sits below the measured value by a margin for platform float differences and guards
+// regressions. They are far from the task issues' targets, which the tasks do not reach
+// yet (docs/benchmarks.md has the figures on the larger dev set and on Mitsuba 3 scenes).
+
+/// Shape from polarization on the ci shape family: measured mean 32.9°, median 28.4°
+/// (targets on the full suite: mean <= 10°, median <= 5°).
+const SFP_CI_MEAN_DEG: f64 = 40.0;
+/// See [`SFP_CI_MEAN_DEG`].
+const SFP_CI_MEDIAN_DEG: f64 = 35.0;
+/// Metal against dielectric on the ci material family: measured 0.935 (target 0.96 clean).
+const MATERIAL_CI_ACCURACY: f64 = 0.85;
+/// Transparent mask IoU on the ci glass family: measured 0.31 (target 0.85 clean).
+const TRANSPARENT_CI_IOU: f64 = 0.2;
+
+use common::{arg, family_mean, json, standard_ci, vision};
+
+/// Runs `eval` on `families` of the ci suite with `tasks` and returns its metrics.json.
+fn eval(families: &str, tasks: &str, jobs: &str) -> (tempfile::TempDir, serde_json::Value) {
+    let out = tempfile::tempdir().unwrap();
+    let data = standard_ci();
+    let ok = vision(&[
+        "eval",
+        arg(data),
+        "--out",
+        arg(out.path()),
+        "--family",
+        families,
+        "--tasks",
+        tasks,
+        "--jobs",
+        jobs,
+    ])
+    .expect("eval completes");
+    assert!(
+        ok,
+        "a task failed on {families}: see {}",
+        out.path().display()
+    );
+    let metrics = json(&out.path().join("metrics.json"));
+    (out, metrics)
+}
+
+#[test]
+fn shape_from_polarization_on_the_ci_shape_family() {
+    let (_dir, m) = eval("sfp", "sfp", "2");
+    let mean = family_mean(&m, "sfp", "sfp", "normal.mean_deg");
+    let median = family_mean(&m, "sfp", "sfp", "normal.median_deg");
+    eprintln!("sfp ci: mean {mean:.2} deg, median {median:.2} deg");
+    assert!(
+        median < SFP_CI_MEDIAN_DEG && mean < SFP_CI_MEAN_DEG,
+        "mean {mean}, median {median}"
+    );
+}
+
+#[test]
+fn dehazing_on_the_ci_haze_family() {
+    let (_dir, m) = eval("haze", "dehaze", "2");
+    let key = |k: &str| family_mean(&m, "haze", "dehaze", k);
+    let (dehazed, hazy) = (
+        key("against_dehazed.dehazed.psnr_db"),
+        key("against_dehazed.hazy.psnr_db"),
+    );
+    let corr = key("against_dehazed.transmission_correlation");
+    eprintln!("haze ci: dehazed {dehazed:.2} dB, hazy {hazy:.2} dB, transmission r {corr:.3}");
+    // Targets on the full family: +4 dB over the hazy input, r >= 0.9 (dev set: +2.6 dB,
+    // r = 0.94). The two 64x64 ci samples at 8 spp measure -0.16 dB and r = 0.90: 1/t
+    // amplifies their noise, so here the output must not lose more than 1 dB and t must
+    // follow the truth.
+    assert!(dehazed > hazy - 1.0, "dehazed {dehazed} dB, hazy {hazy} dB");
+    assert!(corr > 0.8, "transmission correlation {corr}");
+}
+
+#[test]
+fn material_classification_on_the_ci_material_family() {
+    let (_dir, m) = eval("materials", "sfp,material", "2");
+    let acc = family_mean(&m, "materials", "material", "metal_vs_dielectric_accuracy");
+    eprintln!("materials ci: metal vs dielectric {acc:.3}");
+    assert!(acc > MATERIAL_CI_ACCURACY, "accuracy {acc}");
+}
+
+#[test]
+fn transparency_on_the_ci_glass_family() {
+    let (_dir, m) = eval("glass", "transparent", "2");
+    let iou = family_mean(&m, "glass", "transparent", "iou");
+    eprintln!("glass ci: IoU {iou:.3}");
+    assert!(iou > TRANSPARENT_CI_IOU, "IoU {iou}");
+}
+
+#[test]
+fn outputs_are_identical_whatever_the_jobs() {
+    let (a, _) = eval("sfp", "sfp", "1");
+    let (b, _) = eval("sfp", "sfp", "2");
+    for sample in std::fs::read_dir(a.path().join("samples")).unwrap() {
+        let sample = sample.unwrap().file_name();
+        for file in ["normal.exr", "depth.exr", "reflection.png", "stokes.exr"] {
+            let read = |d: &tempfile::TempDir| {
+                std::fs::read(d.path().join("samples").join(&sample).join(file)).unwrap()
+            };
+            assert!(
+                read(&a) == read(&b),
+                "{sample:?}/{file} differs between --jobs 1 and 2"
+            );
+        }
+    }
+}

@@ -1,0 +1,194 @@
+//! Hard cases for every task through `polar-vision run`: frames that are tiny, huge, dark,
+//! saturated, unpolarized, fully polarized or partly undefined. Each must end in a clear
+//! error (for frames with no information at all) or in outputs that are finite where the
+//! conventions define them: unit or zero normals, depth finite or NaN only off the
+//! objects, labels 0..=3, a 0/255 mask, transmission in (0, 1], finite dehazed radiance.
+
+mod common;
+
+use std::path::Path;
+
+use common::{arg, vision};
+use polar_image::{Gray, Image};
+use polar_io::files::vision as out_files;
+
+/// A sample directory holding only `stokes.exr` made of `f(x, y) -> [S0, S1, S2]`.
+fn stokes_sample(dir: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 3]) {
+    std::fs::create_dir_all(dir).unwrap();
+    let data = (0..w * h)
+        .flat_map(|k| {
+            let [s0, s1, s2] = f(k % w, k / w);
+            [s0, s1, s2, 0.0]
+        })
+        .collect();
+    let img = Image::<f32, 4>::from_vec(w, h, data).unwrap();
+    polar_io::write_exr(dir.join("stokes.exr"), &img, polar_io::STOKES_CHANNELS).unwrap();
+}
+
+/// A sample directory holding only a 16-bit `raw.png`.
+fn raw_sample(dir: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> u16) {
+    std::fs::create_dir_all(dir).unwrap();
+    let raw = Gray::from_vec(w, h, (0..w * h).map(|k| f(k % w, k / w)).collect()).unwrap();
+    polar_io::write_gray16_png(dir.join("raw.png"), &raw).unwrap();
+}
+
+/// A lit sphere-like blob: S0 bright in a disc, DoLP rising toward its rim.
+fn blob(w: usize, h: usize, x: usize, y: usize) -> [f32; 3] {
+    let (cx, cy, r) = (w as f32 / 2.0, h as f32 / 2.0, w.min(h) as f32 * 0.35);
+    let (dx, dy) = (x as f32 + 0.5 - cx, y as f32 + 0.5 - cy);
+    let rho = (dx * dx + dy * dy).sqrt() / r;
+    if rho >= 1.0 {
+        return [0.2, 0.0, 0.0];
+    }
+    let dolp = 0.3 * rho * rho;
+    let phi = dy.atan2(dx);
+    [1.0, dolp * (2.0 * phi).cos(), dolp * (2.0 * phi).sin()]
+}
+
+/// Runs every task on `sample`; returns the output folder after checking its outputs.
+fn run_all(sample: &Path) -> tempfile::TempDir {
+    let out = tempfile::tempdir().unwrap();
+    let result = vision(&["run", arg(sample), "--out", arg(out.path())]);
+    assert!(result.is_ok(), "{}: {:?}", sample.display(), result);
+    check_outputs(out.path());
+    out
+}
+
+fn check_outputs(out: &Path) {
+    let read = |name: &str, ch: &str| polar_io::read_exr_channel(out.join(name), ch).ok();
+    if let Ok(fg) = polar_io::read_exr(out.join(out_files::NORMAL), polar_io::RGB_CHANNELS) {
+        for n in fg.pixels() {
+            let len = n.iter().map(|v| v * v).sum::<f32>().sqrt();
+            assert!(len == 0.0 || (len - 1.0).abs() < 1e-3, "normal {n:?}");
+        }
+    }
+    for (name, lo, hi) in [
+        (out_files::TRANSMISSION, f32::MIN_POSITIVE, 1.0),
+        (out_files::DEHAZED, f32::MIN, f32::MAX),
+        (out_files::NORMAL_CONFIDENCE, 0.0, 1.0),
+        (out_files::TRANSPARENT_SCORE, 0.0, 1.0),
+        (out_files::MATERIAL_CONFIDENCE, 0.0, 1.0),
+    ] {
+        if let Some(img) = read(name, "Y") {
+            let bad = img
+                .as_slice()
+                .iter()
+                .find(|v| !(v.is_finite() && **v >= lo && **v <= hi));
+            assert!(bad.is_none(), "{name}: {bad:?} outside [{lo}, {hi}]");
+        }
+    }
+    if let Some(depth) = read(out_files::DEPTH, "Y") {
+        assert!(
+            depth.as_slice().iter().all(|v| v.is_finite() || v.is_nan()),
+            "depth ±inf"
+        );
+    }
+    if let Ok(labels) = polar_io::read_gray8_png(out.join(out_files::MATERIAL)) {
+        assert!(
+            labels.as_slice().iter().all(|&l| l <= 3),
+            "material label > 3"
+        );
+    }
+    if let Ok(mask) = polar_io::read_gray8_png(out.join(out_files::TRANSPARENT)) {
+        assert!(
+            mask.as_slice().iter().all(|&m| m == 0 || m == 255),
+            "mask not 0/255"
+        );
+    }
+}
+
+#[test]
+fn two_by_two_frames_run_every_task() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("tiny");
+    stokes_sample(&s, 2, 2, |x, y| [1.0 + x as f32, 0.1 * y as f32, 0.0]);
+    run_all(&s);
+    let r = dir.path().join("tiny-raw");
+    raw_sample(&r, 2, 2, |x, y| 1000 + 300 * (x + 2 * y) as u16);
+    run_all(&r);
+}
+
+#[test]
+fn unpolarized_and_fully_polarized_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let flat = dir.path().join("dolp0");
+    stokes_sample(&flat, 32, 24, |x, y| {
+        [0.5 + 0.01 * (x + y) as f32, 0.0, 0.0]
+    });
+    run_all(&flat);
+    let full = dir.path().join("dolp1");
+    stokes_sample(&full, 32, 24, |x, _| {
+        let a = x as f32 * 0.2;
+        [1.0, a.cos(), a.sin()]
+    });
+    run_all(&full);
+}
+
+#[test]
+fn zero_and_undefined_pixels_inside_a_valid_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("holes");
+    stokes_sample(&s, 40, 30, |x, y| match (x + 3 * y) % 11 {
+        0 => [0.0, 0.0, 0.0],
+        1 => [f32::NAN, 0.0, 0.0],
+        _ => blob(40, 30, x, y),
+    });
+    run_all(&s);
+}
+
+#[test]
+fn all_black_and_all_white_raw_frames_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let black = dir.path().join("black");
+    raw_sample(&black, 16, 16, |_, _| 0);
+    let out = tempfile::tempdir().unwrap();
+    let err = vision(&["run", arg(&black), "--out", arg(out.path())]).unwrap_err();
+    assert!(err.contains("every pixel is 0"), "{err}");
+    let white = dir.path().join("white");
+    raw_sample(&white, 16, 16, |_, _| u16::MAX);
+    let err = vision(&["run", arg(&white), "--out", arg(out.path())]).unwrap_err();
+    assert!(err.contains("saturated"), "{err}");
+}
+
+#[test]
+fn an_all_dark_stokes_frame_gives_documented_empty_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("dark");
+    stokes_sample(&s, 16, 16, |_, _| [0.0, 0.0, 0.0]);
+    let out = run_all(&s);
+    let normals = polar_io::read_exr(out.path().join(out_files::NORMAL), polar_io::RGB_CHANNELS);
+    assert!(
+        normals.unwrap().as_slice().iter().all(|&v| v == 0.0),
+        "normals on a dark frame"
+    );
+}
+
+#[test]
+fn partly_saturated_raw_frames_flag_and_go_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("sat");
+    raw_sample(&s, 48, 32, |x, y| {
+        let [s0, s1, s2] = blob(48, 32, x, y);
+        let theta = [[90.0f32, 45.0], [135.0, 0.0]][y % 2][x % 2].to_radians();
+        let i = 0.5 * (s0 + s1 * (2.0 * theta).cos() + s2 * (2.0 * theta).sin());
+        if x < 6 {
+            4095
+        } else {
+            (i * 3000.0) as u16 + 20
+        }
+    });
+    run_all(&s);
+}
+
+#[test]
+fn an_eight_megapixel_frame_runs_every_task() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("big");
+    let (w, h) = (3264, 2448);
+    raw_sample(&s, w, h, |x, y| {
+        let [s0, s1, s2] = blob(w, h, x, y);
+        let theta = [[90.0f32, 45.0], [135.0, 0.0]][y % 2][x % 2].to_radians();
+        (2000.0 * (s0 + s1 * (2.0 * theta).cos() + s2 * (2.0 * theta).sin())) as u16 + 50
+    });
+    run_all(&s);
+}

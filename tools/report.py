@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""Speed against error of every vision task, over its options, on a polar-datagen dataset.
+
+For each task it runs `polar-vision eval` on the task's families once per option set and
+reads the evaluation's metrics.json (the mean of the task's headline error over the
+family's samples, and the task's mean seconds per megapixel, as the CLI measures them).
+It writes one PNG plot per task (error against time) under docs/img/ and the tables into
+docs/benchmarks.md between the markers `<!-- report:begin -->` and `<!-- report:end -->`.
+Run on demand, not in CI:
+
+    cargo build --release -p polar-vision
+    tools/.venv/bin/python tools/report.py DATASET [--extra NAME=DATASET ...]
+
+DATASET is a polar-datagen output (e.g. of /work/data/dev.toml or the standard suite);
+each --extra dataset (e.g. scenes rendered by Mitsuba 3, tools/mitsuba/task_scenes.py) is
+evaluated with the same options and reported beside it: the generalization gap.
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+BIN = ROOT / "target/release/polar-vision"
+DOC = ROOT / "docs/benchmarks.md"
+IMG = ROOT / "docs/img"
+
+# task -> (families by prefix, headline metric key, label, lower is better, option sets)
+TASKS = {
+    "sfp": (["sfp"], "normal.mean_deg", "mean angular error (deg)", True, {
+        "local + poisson": ["--sfp-method", "local", "--integrator", "poisson"],
+        "local + fc": ["--sfp-method", "local", "--integrator", "fc"],
+        "global": ["--sfp-method", "global"],
+        "local, bilinear demosaic": ["--sfp-method", "local", "--demosaic", "bilinear"],
+    }),
+    "material": (["materials"], "metal_vs_dielectric_accuracy", "metal vs dielectric accuracy",
+                 False, {"physics rule, with sfp normals": ["--tasks", "sfp,material"],
+                         "physics rule, no normals": ["--tasks", "material"]}),
+    "transparent": (["glass"], "iou", "mask IoU", False, {"training-free": []}),
+    "dehaze": (["haze"], "against_dehazed.dehazed.psnr_db", "PSNR vs gt/dehazed (dB)", False, {
+        "polarization": ["--dehaze-method", "polarization"],
+        "dark channel": ["--dehaze-method", "dark-channel"],
+    }),
+}
+
+
+def families_of(dataset: Path) -> list:
+    names = {p.name.rsplit("-", 1)[0] for p in dataset.iterdir() if p.is_dir() and not p.name.startswith(".")}
+    return sorted(names)
+
+
+def evaluate(dataset: Path, task: str, families: list, options: list) -> dict:
+    """Runs eval; returns {family: (mean headline, seconds per MP, samples)}."""
+    tasks = options[options.index("--tasks") + 1] if "--tasks" in options else task
+    rest = [o for i, o in enumerate(options) if o != "--tasks" and (i == 0 or options[i - 1] != "--tasks")]
+    with tempfile.TemporaryDirectory() as out:
+        cmd = [str(BIN), "eval", str(dataset), "--out", out, "--tasks", tasks,
+               "--family", ",".join(families), *rest]
+        subprocess.run(cmd, check=False, capture_output=True)
+        metrics = json.loads((Path(out) / "metrics.json").read_text())
+    result = {}
+    for fam, per_task in metrics["families"].items():
+        agg = per_task.get(task)
+        if agg:
+            result[fam] = (agg["means"].get(TASKS[task][1]), agg["seconds_per_mp"], agg["samples"])
+    return result
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dataset", type=Path)
+    ap.add_argument("--extra", action="append", default=[], help="NAME=DATASET evaluated beside it")
+    args = ap.parse_args()
+    if not BIN.exists():
+        sys.exit(f"{BIN} missing: cargo build --release -p polar-vision")
+    sets = [("ours", args.dataset)] + [tuple(e.split("=", 1)) for e in args.extra]
+    IMG.mkdir(parents=True, exist_ok=True)
+    lines = []
+    for task, (prefixes, key, label, lower, options) in TASKS.items():
+        lines += [f"### {task}: {label} against time", "",
+                  "| data | family | option | " + label + " | s / MP | samples |", "|---|---|---|---|---|---|"]
+        fig, ax = plt.subplots(figsize=(6, 4))
+        for name, path in sets:
+            path = Path(path)
+            fams = [f for f in families_of(path) if any(f.startswith(p) or p in f for p in prefixes)]
+            if not fams:
+                continue
+            for opt_name, opts in options.items():
+                res = evaluate(path, task, fams, opts)
+                for fam, (value, spm, n) in sorted(res.items()):
+                    v = "-" if value is None else f"{value:.3f}"
+                    s = "-" if spm is None else f"{spm:.3f}"
+                    lines.append(f"| {name} | {fam} | {opt_name} | {v} | {s} | {n} |")
+                    if value is not None and spm is not None:
+                        ax.scatter(spm, value, label=f"{name} {fam}: {opt_name}")
+        ax.set_xscale("log")
+        ax.set_xlabel("seconds per megapixel (2 cores)")
+        ax.set_ylabel(label + (" (lower is better)" if lower else " (higher is better)"))
+        ax.legend(fontsize=6)
+        fig.tight_layout()
+        fig.savefig(IMG / f"report-{task}.png", dpi=110)
+        plt.close(fig)
+        lines += ["", f"![{task}](img/report-{task}.png)", ""]
+        print(f"{task}: done", file=sys.stderr)
+    text = DOC.read_text() if DOC.exists() else "# Benchmarks\n\n<!-- report:begin -->\n<!-- report:end -->\n"
+    head, _, rest = text.partition("<!-- report:begin -->")
+    _, _, tail = rest.partition("<!-- report:end -->")
+    DOC.write_text(head + "<!-- report:begin -->\n" + "\n".join(lines) + "\n<!-- report:end -->" + tail)
+    print(f"wrote {DOC}")
+
+
+if __name__ == "__main__":
+    main()
