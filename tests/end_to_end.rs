@@ -110,3 +110,56 @@ fn outputs_are_identical_whatever_the_jobs() {
         }
     }
 }
+
+#[test]
+fn bad_samples_are_recorded_and_the_rest_go_on() {
+    let data = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    // An empty dataset folder is a clear error.
+    let err = vision(&["eval", arg(data.path()), "--out", arg(out.path())]).unwrap_err();
+    assert!(err.contains("no sample directories"), "{err}");
+    // One good sample, one with a corrupt raw.png, one whose gt is of another size.
+    let src = standard_ci().join("sfp-00000");
+    for name in ["good-0", "corrupt-0", "mismatch-0"] {
+        let dst = data.path().join(name);
+        std::fs::create_dir_all(dst.join("gt")).unwrap();
+        for f in ["meta.json", "raw.png", "gt/normal.exr", "gt/material.png"] {
+            std::fs::copy(src.join(f), dst.join(f)).unwrap();
+        }
+    }
+    std::fs::write(
+        data.path().join("corrupt-0/raw.png"),
+        b"\x89PNG\r\n\x1a\ntruncated",
+    )
+    .unwrap();
+    let small = polar_image::Gray::from_vec(2, 2, vec![1u8; 4]).unwrap();
+    polar_io::write_gray8_png(data.path().join("mismatch-0/gt/material.png"), &small).unwrap();
+    std::fs::remove_file(data.path().join("mismatch-0/gt/normal.exr")).unwrap();
+    let ok = vision(&[
+        "eval",
+        arg(data.path()),
+        "--out",
+        arg(out.path()),
+        "--tasks",
+        "sfp",
+    ]);
+    assert_eq!(ok, Ok(false), "eval completes and reports the failures");
+    let m = json(&out.path().join("metrics.json"));
+    let err = |s: &str| {
+        m["samples"][s]["Err"]
+            .as_str()
+            .unwrap_or_default()
+            .to_owned()
+    };
+    assert!(m["samples"]["good-0"]["Ok"].is_object());
+    assert!(
+        err("corrupt-0").contains("corrupt-0/raw.png"),
+        "{}",
+        err("corrupt-0")
+    );
+    assert!(
+        err("mismatch-0").contains("ground truth is 2x2"),
+        "{}",
+        err("mismatch-0")
+    );
+}

@@ -35,13 +35,13 @@ IMG = ROOT / "docs/img"
 
 # task -> (families by prefix, headline metric key, label, lower is better, option sets)
 TASKS = {
-    "sfp": (["sfp"], "normal.mean_deg", "mean angular error (deg)", True, {
+    "sfp": (["sfp", "mts-shape"], "normal.mean_deg", "mean angular error (deg)", True, {
         "local + poisson": ["--sfp-method", "local", "--integrator", "poisson"],
         "local + fc": ["--sfp-method", "local", "--integrator", "fc"],
         "global": ["--sfp-method", "global"],
         "local, bilinear demosaic": ["--sfp-method", "local", "--demosaic", "bilinear"],
     }),
-    "material": (["materials"], "metal_vs_dielectric_accuracy", "metal vs dielectric accuracy",
+    "material": (["materials", "mts-material"], "metal_vs_dielectric_accuracy", "metal vs dielectric accuracy",
                  False, {"physics rule, with sfp normals": ["--tasks", "sfp,material"],
                          "physics rule, no normals": ["--tasks", "material"]}),
     "transparent": (["glass"], "iou", "mask IoU", False, {"training-free": []}),
@@ -90,7 +90,7 @@ def main():
         fig, ax = plt.subplots(figsize=(6, 4))
         for name, path in sets:
             path = Path(path)
-            fams = [f for f in families_of(path) if any(f.startswith(p) or p in f for p in prefixes)]
+            fams = [f for f in families_of(path) if any(f.startswith(p) or f"-{p}" in f for p in prefixes)]
             if not fams:
                 continue
             for opt_name, opts in options.items():
