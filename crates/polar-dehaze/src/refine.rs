@@ -23,7 +23,7 @@ pub fn refine(
             &input.s0,
             &filled,
             &mut t,
-            safe_radius(opts.guided_radius, raw.width()),
+            opts.guided_radius,
             f64::from(eps),
         )?;
     } else {
@@ -38,13 +38,6 @@ pub fn refine(
         }
     });
     Ok(t)
-}
-
-/// `radius`, reduced to 4 on images narrower than 16 pixels: `polar_imgproc::box_filter`
-/// indexes out of bounds for windows wider than 9 on some widths below 10 (1, 2, 3, 5, 6,
-/// 9), and on such images a 9-wide window already spans most of the row.
-fn safe_radius(radius: usize, width: usize) -> usize {
-    if width < 16 { radius.min(4) } else { radius }
 }
 
 /// Replaces NaN values by the mean of the known values in the `(2 radius + 1)^2` window
@@ -86,7 +79,7 @@ fn window_sums(
     r: usize,
 ) -> Result<(Vec<f32>, Vec<f32>), DehazeError> {
     let (w, h) = raw.size();
-    let k = 2 * safe_radius(r, w) + 1;
+    let k = 2 * r + 1;
     let vals: Vec<f32> = raw
         .as_slice()
         .iter()
@@ -152,7 +145,6 @@ pub fn denoise(input: &Normalized, t: &Gray<f32>, radius: usize) -> Result<Gray<
     if radius == 0 || eps <= 0.0 || !eps.is_finite() {
         return Ok(input.s0.clone());
     }
-    let radius = safe_radius(radius, input.s0.width());
     let mut out = Gray::new(input.s0.width(), input.s0.height());
     guided_filter(&input.s0, &input.s0, &mut out, radius, eps)?;
     out.as_mut_slice()
