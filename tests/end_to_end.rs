@@ -163,3 +163,37 @@ fn bad_samples_are_recorded_and_the_rest_go_on() {
         err("mismatch-0")
     );
 }
+
+#[test]
+fn run_outputs_are_identical_whatever_the_threads() {
+    let sample = standard_ci().join("materials-00001");
+    let outs: Vec<tempfile::TempDir> = ["1", "3"]
+        .iter()
+        .map(|threads| {
+            let out = tempfile::tempdir().unwrap();
+            let ok = vision(&[
+                "run",
+                arg(&sample),
+                "--out",
+                arg(out.path()),
+                "--threads",
+                threads,
+            ]);
+            assert_eq!(ok, Ok(true), "run with --threads {threads}");
+            out
+        })
+        .collect();
+    for file in [
+        "normal.exr",
+        "depth.exr",
+        "material.png",
+        "transparent.png",
+        "dehazed.exr",
+    ] {
+        let read = |d: &tempfile::TempDir| std::fs::read(d.path().join(file)).unwrap();
+        assert!(
+            read(&outs[0]) == read(&outs[1]),
+            "{file} differs between --threads 1 and 3"
+        );
+    }
+}

@@ -79,13 +79,11 @@ impl SampleReport {
 
 /// Runs the subcommand; `Ok(false)` when a task could not run.
 pub fn run(args: &RunArgs) -> Result<bool, CliError> {
-    if let Some(n) = args.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(usize::from(n))
-            .build_global()
-            .map_err(|e| CliError::Threads(e.to_string()))?;
-    }
-    let report = run_sample(&args.sample, &args.out, args)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.map_or(0, usize::from))
+        .build()
+        .map_err(|e| CliError::Threads(e.to_string()))?;
+    let report = pool.install(|| run_sample(&args.sample, &args.out, args))?;
     report
         .warnings
         .iter()
