@@ -59,6 +59,11 @@ pub enum CliError {
     /// Every pixel is zero: no light, nothing to compute (DoLP/AoLP undefined everywhere).
     #[error("{0}: every pixel is 0 (no light); DoLP and AoLP would be undefined everywhere")]
     AllZero(PathBuf),
+    /// No pixel of a Stokes image has a positive finite S0 (all zero, negative or NaN).
+    #[error(
+        "{0}: no pixel has a positive, finite S0 (no light); DoLP and AoLP would be undefined everywhere"
+    )]
+    NoLight(PathBuf),
     /// Every pixel is at the saturation level: the intensities are unknown.
     #[error(
         "{path}: every pixel is saturated (at {level} DN for {bits}-bit data); Stokes images would be meaningless"

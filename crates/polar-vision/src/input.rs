@@ -130,6 +130,14 @@ pub fn read_observation(
         }
         InputFile::Stokes(path) => {
             let stokes = polar_io::read_exr(path, LINEAR_STOKES_CHANNELS)?;
+            // As for a raw frame with no light: nothing can be computed anywhere.
+            if !stokes
+                .pixels()
+                .iter()
+                .any(|p| p[0] > 0.0 && p[0].is_finite())
+            {
+                return Err(CliError::NoLight(path.to_owned()));
+            }
             let planes = StokesPlanes::from_linear_stokes(&stokes);
             Ok((Observation::new(planes, CameraModel::Orthographic), vec![]))
         }
