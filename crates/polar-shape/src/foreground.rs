@@ -21,9 +21,8 @@
 //! for an object cut by the border on all sides or a background split off by shadows.
 
 use polar_image::Gray;
-use polar_imgproc::{
-    Connectivity, MorphShape, dilate, erode, gaussian_blur, label, open, sobel, threshold_otsu,
-};
+use polar_imgproc::mask::fill_holes;
+use polar_imgproc::{MorphShape, dilate, erode, gaussian_blur, open, sobel, threshold_otsu};
 
 use crate::ShapeError;
 use crate::cues::Cues;
@@ -105,23 +104,10 @@ pub fn edge_strength(cues: &Cues) -> Result<Gray<f32>, ShapeError> {
     Ok(Gray::from_vec(w, h, g.into_iter().map(f32::sqrt).collect()).expect("sized"))
 }
 
-/// Pixels of the edge-free 4-connected regions that touch the image border.
+/// Pixels of the edge-free 4-connected regions that touch the image border: the
+/// complement of the edge mask with its holes filled.
 fn border_regions(edges: &[bool], w: usize, h: usize) -> Result<Vec<bool>, ShapeError> {
-    let calm = Gray::from_vec(w, h, edges.iter().map(|&e| u8::from(!e)).collect()).expect("sized");
-    let mut labels = Gray::new(w, h);
-    let n = label(&calm, &mut labels, Connectivity::Four)?;
-    let mut touches = vec![false; n + 1];
-    let l = labels.as_slice();
-    for x in 0..w {
-        touches[l[x] as usize] = true;
-        touches[l[(h - 1) * w + x] as usize] = true;
-    }
-    for y in 0..h {
-        touches[l[y * w] as usize] = true;
-        touches[l[y * w + w - 1] as usize] = true;
-    }
-    touches[0] = false;
-    Ok(l.iter().map(|&c| touches[c as usize]).collect())
+    Ok(fill_holes(edges, w, h)?.into_iter().map(|v| !v).collect())
 }
 
 /// A 3x3 square morphological operation on a mask.
