@@ -6,12 +6,15 @@
 //! allowed, sizes that disagree within a sample. Every writer is atomic (temporary sibling,
 //! then rename), so a crash never leaves a half-written file under the final name.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 mod atomic;
 mod error;
 mod openexr;
 mod png;
 mod sample;
 mod shard;
+mod staged;
 mod validate;
 
 pub use error::{Error, Result};
@@ -27,22 +30,37 @@ pub use sample::{
     read_optional_meta, read_sample, read_sample_with, write_json, write_sample,
 };
 pub use shard::{Shard, ShardError};
+pub use staged::{StagedDir, check_replaceable};
 pub use validate::{Rule, Validation, check_channels, check_stokes, check_u8};
 
-/// The most pixels an image may have to be read: 100 megapixels, 40 times a 5-MP sensor.
-/// Checked from the file's header before any pixel buffer is allocated, so a small file
-/// that claims a huge image is refused at once instead of exhausting memory.
+/// The default of the most pixels an image may have to be read: 100 megapixels, 20 times
+/// a 5-MP sensor. Checked from the file's header before any pixel buffer is allocated, so
+/// a small file that claims a huge image is refused at once instead of exhausting memory.
 pub const MAX_PIXELS: usize = 100_000_000;
 
-/// Refuses a `width × height` image of more than [`MAX_PIXELS`].
+static PIXEL_LIMIT: AtomicUsize = AtomicUsize::new(MAX_PIXELS);
+
+/// Sets the pixel limit of every reader in this process (default [`MAX_PIXELS`]); a
+/// program sets it once from its options (e.g. `polar-vision --max-pixels`).
+pub fn set_max_pixels(limit: usize) {
+    PIXEL_LIMIT.store(limit, Ordering::Relaxed);
+}
+
+/// The pixel limit of the readers ([`set_max_pixels`]).
+pub fn max_pixels() -> usize {
+    PIXEL_LIMIT.load(Ordering::Relaxed)
+}
+
+/// Refuses a `width × height` image of more than [`max_pixels`].
 pub(crate) fn check_pixels(path: &std::path::Path, width: usize, height: usize) -> Result<()> {
+    let max = max_pixels();
     match width.checked_mul(height) {
-        Some(n) if n <= MAX_PIXELS => Ok(()),
+        Some(n) if n <= max => Ok(()),
         _ => Err(Error::TooLarge {
             path: path.to_owned(),
             width,
             height,
-            max: MAX_PIXELS,
+            max,
         }),
     }
 }

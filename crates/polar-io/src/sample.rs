@@ -76,6 +76,9 @@ pub mod files {
         pub const METRICS: &str = "metrics.json";
         /// Folder of 8-bit pictures for people.
         pub const PICTURES: &str = "pictures";
+        /// Marker of an output folder written by polar-vision: only a folder that holds it
+        /// (or an empty one) is replaced by a later run.
+        pub const MARKER: &str = ".polar-vision";
     }
 }
 

@@ -37,20 +37,23 @@ pub fn linear(s0: f64, theta: f64) -> Stokes {
 }
 
 /// Degree of linear polarization `sqrt(S1² + S2²) / S0`; NaN where `S0` is zero or not finite.
+/// Formed as `hypot(S1/S0, S2/S0)`, which does not overflow for Stokes values near the
+/// float maximum (`hypot(S1, S2)` alone can exceed it where `S0` does not).
 #[inline]
 pub fn dolp<T: Float>(s0: T, s1: T, s2: T) -> T {
     if s0 > T::zero() && s0.is_finite() {
-        s1.hypot(s2) / s0
+        (s1 / s0).hypot(s2 / s0)
     } else {
         T::nan()
     }
 }
 
 /// Degree of polarization `sqrt(S1² + S2² + S3²) / S0`; NaN where `S0` is zero or not finite.
+/// Scaled by `S0` first, as [`dolp`].
 #[inline]
 pub fn dop<T: Float>(s0: T, s1: T, s2: T, s3: T) -> T {
     if s0 > T::zero() && s0.is_finite() {
-        s1.hypot(s2).hypot(s3) / s0
+        (s1 / s0).hypot(s2 / s0).hypot(s3 / s0)
     } else {
         T::nan()
     }

@@ -211,6 +211,17 @@ fn stokes_nan_and_inf_inputs() {
     assert_eq!(stokes::ellipticity_angle(1.0, 0.0, 0.0, 0.0), 0.0);
 }
 
+/// Stokes values near the float maximum (an f32 frame from another tool): forming
+/// `hypot(S1, S2)` before dividing by S0 overflows to an infinite DoLP.
+#[test]
+fn stokes_dolp_near_float_max_is_finite() {
+    let d = stokes::dolp(3e38f32, -3e38, -3e38);
+    assert!((d - std::f32::consts::SQRT_2).abs() < 1e-6, "DoLP {d}");
+    assert_eq!(stokes::dolp(f32::MAX, f32::MAX, 0.0), 1.0);
+    let p = stokes::dop(f64::MAX, f64::MAX, f64::MAX, f64::MAX);
+    assert!((p - 3f64.sqrt()).abs() < 1e-12, "DoP {p}");
+}
+
 #[test]
 fn least_squares_fewer_than_3_distinct_angles_is_an_error() {
     let e = LinearStokesFit::new(&[0.0, 1.0]).unwrap_err();

@@ -1,7 +1,7 @@
 //! DoLP and AoLP of `polar_optics::stokes` in branch-free form, so that row loops
 //! vectorise (the library `hypot`/`atan2` calls do not).
 //!
-//! Same definitions: `DoLP = sqrt(S1² + S2²) / S0`, `AoLP = ½ atan2(S2, S1)` wrapped to
+//! Same definitions: `DoLP = sqrt((S1/S0)² + (S2/S0)²)`, `AoLP = ½ atan2(S2, S1)` wrapped to
 //! `[0, π)`, both NaN where `S0` is not positive or not finite, AoLP 0 where
 //! `S1 = S2 = 0`. `atan2` is the Cephes single-precision arctangent (range reduction
 //! to `|t| <= tan(π/8)` and a degree-9 odd polynomial, about 1 ulp); tests bound the
@@ -33,7 +33,9 @@ fn atan2(y: f32, x: f32) -> f32 {
 #[inline(always)]
 pub fn dolp_aolp(s0: f32, s1: f32, s2: f32) -> (f32, f32) {
     let defined = s0 > 0.0 && s0.is_finite();
-    let d = (s1 * s1 + s2 * s2).sqrt() / s0;
+    // Scaled by S0 before squaring: no overflow for Stokes values near f32::MAX.
+    let (u, v) = (s1 / s0, s2 / s0);
+    let d = (u * u + v * v).sqrt();
     let a = 0.5 * atan2(s2, s1);
     let a = if a < 0.0 { a + PI } else { a };
     let a = if a >= PI { 0.0 } else { a };
@@ -96,5 +98,16 @@ mod tests {
             let (d, a) = dolp_aolp(s0, 0.5, 0.5);
             assert!(d.is_nan() && a.is_nan(), "S0 = {s0}");
         }
+    }
+
+    /// Stokes values near `f32::MAX` (a float frame from elsewhere): squaring S1 and S2
+    /// before dividing by S0 would overflow to an infinite DoLP.
+    #[test]
+    fn dolp_near_float_max_does_not_overflow() {
+        let (d, a) = dolp_aolp(3e38, -3e38, -3e38);
+        assert!((d - std::f32::consts::SQRT_2).abs() < 1e-6, "DoLP {d}");
+        assert!((a - 5.0 * PI / 8.0).abs() < 1e-6, "AoLP {a}");
+        let (d, _) = dolp_aolp(f32::MAX, f32::MAX, 0.0);
+        assert_eq!(d, 1.0);
     }
 }

@@ -15,6 +15,12 @@ use crate::{eval, run, stokes};
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The most pixels an input image may have; larger ones are refused from their header,
+    /// before any memory is allocated (a small corrupt file can claim a huge image).
+    /// The default, 100 megapixels, is 20 times a 5-MP polarization sensor.
+    #[arg(long, global = true, value_name = "N", default_value_t = polar_io::MAX_PIXELS,
+          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    max_pixels: usize,
 }
 
 /// The subcommands.
@@ -44,6 +50,7 @@ where
 
 /// Runs a parsed command line.
 pub fn dispatch(cli: Cli) -> Result<bool, CliError> {
+    polar_io::set_max_pixels(cli.max_pixels);
     match cli.command {
         Command::Stokes(args) => stokes::run(&args).map(|()| true),
         Command::Run(args) => run::run(&args),

@@ -14,8 +14,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::CliError;
+use crate::out_dir::prepare_resumable;
 use crate::run::{RunArgs, SampleReport, run_sample};
-use crate::stokes::prepare_out;
 
 /// Per-sample record kept under `OUT/samples/<name>/`, what makes a run resumable.
 const RECORD: &str = "eval.json";
@@ -52,7 +52,8 @@ pub struct EvalArgs {
 /// `run`'s options as `eval` takes them (the sample comes from the dataset).
 #[derive(Debug, Args)]
 pub struct EvalRunArgs {
-    /// Output directory (created if missing; must be new or hold this same evaluation).
+    /// Output directory: new, empty, or an earlier output of polar-vision (an evaluation
+    /// with the same options resumes in it; samples run again are replaced as a whole).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Tasks, comma-separated (default: all).
@@ -128,7 +129,7 @@ pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
         .map(|(_, s)| s)
         .collect();
     let out = &args.run.out;
-    prepare_out(out)?;
+    prepare_resumable(out)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.map_or(0, usize::from))
         .build()
@@ -182,7 +183,7 @@ pub fn merge(args: &MergeArgs) -> Result<bool, CliError> {
     if samples.is_empty() {
         return Err(CliError::NoSamples(args.shards[0].clone()));
     }
-    prepare_out(&args.out)?;
+    prepare_resumable(&args.out)?;
     let report = write_report(&args.out, samples)?;
     print_failures(&report);
     Ok(report.samples.values().all(Result::is_ok))
@@ -237,7 +238,7 @@ fn evaluate_one(
         options: fingerprint.to_owned(),
         result,
     };
-    std::fs::create_dir_all(&dir).map_err(|e| CliError::write(&dir, e))?;
+    prepare_resumable(&dir)?;
     polar_io::write_json(&path, &record)?;
     Ok((name, record))
 }

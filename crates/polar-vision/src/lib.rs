@@ -7,6 +7,7 @@ pub mod cli;
 pub mod error;
 pub mod eval;
 pub mod input;
+pub mod out_dir;
 pub mod pictures;
 pub mod run;
 pub mod stokes;

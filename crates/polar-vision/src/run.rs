@@ -12,7 +12,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::CliError;
 use crate::input::{InputArgs, InputFile, Source, camera_model, read_observation, resolve};
-use crate::stokes::{Output, check_out_apart, prepare_out, write_outputs};
+use crate::out_dir;
+use crate::stokes::{Output, write_outputs};
 use crate::task_options::TaskArgs;
 use crate::tasks::{Context, Failure, Task};
 
@@ -31,7 +32,8 @@ pub struct RunArgs {
     /// A sample directory (raw.png and/or stokes.exr, optional meta.json and gt/), or a raw
     /// mosaic PNG.
     pub sample: PathBuf,
-    /// Output directory (created if missing).
+    /// Output directory: new, empty, or an earlier output of polar-vision, which is
+    /// replaced as a whole once every file is written.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Tasks to run, comma-separated (default: all). They run in the order sfp,
@@ -102,8 +104,7 @@ pub fn run(args: &RunArgs) -> Result<bool, CliError> {
 /// the report (also written as `metrics.json` where the sample has ground truth).
 pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleReport, CliError> {
     let file = resolve(sample, args.input)?;
-    check_out_apart(sample, out)?;
-    prepare_out(out)?;
+    out_dir::check(sample, out)?;
     let start = Instant::now();
     let dir = sample.is_dir().then_some(sample);
     let meta = dir.map(polar_io::read_optional_meta).transpose()?.flatten();
@@ -116,6 +117,8 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
     check_gt_size(sample, &gt, obs.size())?;
     let read_seconds = start.elapsed().as_secs_f64();
     let raw_mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
+    let staged = out_dir::stage(out)?;
+    let out = staged.path();
     write_outputs(out, &obs.planes, raw_mask, &Output::ALL)?;
     std::fs::create_dir_all(out.join(vision::PICTURES))
         .map_err(|e| CliError::write(out.join(vision::PICTURES), e))?;
@@ -164,6 +167,7 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
     if has_any(&gt) {
         polar_io::write_json(out.join(vision::METRICS), &report)?;
     }
+    out_dir::commit(staged)?;
     Ok(report)
 }
 

@@ -13,6 +13,7 @@ use rayon::prelude::*;
 
 use crate::error::CliError;
 use crate::input::{InputArgs, InputFile, read_observation, resolve};
+use crate::out_dir;
 
 /// Arguments of `polar-vision stokes`.
 #[derive(Debug, Args)]
@@ -26,7 +27,8 @@ pub struct StokesArgs {
     /// A raw mosaic PNG (8- or 16-bit grayscale, IMX250MZR layout), or a sample directory
     /// holding raw.png (or, without raw.png, stokes.exr).
     pub input: PathBuf,
-    /// Output directory (created if missing).
+    /// Output directory: new, empty, or an earlier output of polar-vision, which is
+    /// replaced as a whole once every file is written.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// How to read the input.
@@ -38,88 +40,18 @@ pub struct StokesArgs {
     pub outputs: Vec<Output>,
 }
 
-/// Refuses an output folder that would overwrite the input: the input sample directory
-/// itself or a folder inside it, or the folder of an input file.
-pub fn check_out_apart(input: &Path, out: &Path) -> Result<(), CliError> {
-    let (base, inside_too) = if input.is_dir() {
-        (input.to_owned(), true)
-    } else {
-        let parent = input.parent().filter(|p| !p.as_os_str().is_empty());
-        (parent.unwrap_or(Path::new(".")).to_owned(), false)
-    };
-    let Ok(base) = base.canonicalize() else {
-        return Ok(());
-    };
-    let out_abs = absolute_existing_prefix(out);
-    let clash = if inside_too {
-        out_abs.starts_with(&base)
-    } else {
-        out_abs == base
-    };
-    if clash {
-        return Err(CliError::OutDir {
-            path: out.to_owned(),
-            reason: format!(
-                "it is {} the input {}; its files would be overwritten",
-                if out_abs == base {
-                    "the folder of"
-                } else {
-                    "inside"
-                },
-                input.display()
-            ),
-        });
-    }
-    Ok(())
-}
-
-/// `path` made absolute through its longest existing ancestor (the rest appended as is).
-fn absolute_existing_prefix(path: &Path) -> PathBuf {
-    let mut rest = Vec::new();
-    let mut p = path.to_owned();
-    loop {
-        if let Ok(c) = p.canonicalize() {
-            return rest.iter().rev().fold(c, |acc, part| acc.join(part));
-        }
-        match (p.file_name().map(|n| n.to_owned()), p.parent()) {
-            (Some(name), Some(parent)) => {
-                rest.push(name);
-                p = if parent.as_os_str().is_empty() {
-                    PathBuf::from(".")
-                } else {
-                    parent.to_owned()
-                };
-            }
-            _ => return path.to_owned(),
-        }
-    }
-}
-
-/// Creates the output directory (or checks it is one).
-pub fn prepare_out(out: &Path) -> Result<(), CliError> {
-    if out.exists() && !out.is_dir() {
-        return Err(CliError::OutDir {
-            path: out.to_owned(),
-            reason: "exists and is not a directory".into(),
-        });
-    }
-    std::fs::create_dir_all(out).map_err(|e| CliError::OutDir {
-        path: out.to_owned(),
-        reason: e.to_string(),
-    })
-}
-
 /// Runs the subcommand.
 pub fn run(args: &StokesArgs) -> Result<(), CliError> {
     let file = resolve(&args.input, None)?;
-    check_out_apart(&args.input, &args.out)?;
-    prepare_out(&args.out)?;
+    out_dir::check(&args.input, &args.out)?;
     let start = Instant::now();
     let (obs, warnings) = read_observation(&file, &args.read)?;
     warnings.iter().for_each(|w| eprintln!("warning: {w}"));
     let mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let computed = start.elapsed();
-    write_outputs(&args.out, &obs.planes, mask, &args.outputs)?;
+    let staged = out_dir::stage(&args.out)?;
+    write_outputs(staged.path(), &obs.planes, mask, &args.outputs)?;
+    out_dir::commit(staged)?;
     let (w, h) = obs.size();
     eprintln!(
         "{w}x{h} ({}) in {:.1} ms, outputs in {:.1} ms -> {}",

@@ -248,7 +248,43 @@ fn truncated_non_png_missing_input_and_bad_arguments() {
     );
     fails_with(&["stokes", p(&good)], "--out");
     // --out naming a file is rejected before any work.
-    fails_with(&["stokes", p(&good), "--out", p(&good)], "not a directory");
+    fails_with(&["stokes", p(&good), "--out", p(&good)], "not a folder");
+    assert!(
+        !out.exists(),
+        "a failed run must not leave its output folder"
+    );
+}
+
+/// A rerun replaces the whole output set (no stale file of the earlier run stays), and a
+/// user's own non-empty folder is refused and left as it was (hostile-input issue, item 10).
+#[test]
+fn out_folder_is_replaced_as_a_whole_and_a_user_folder_is_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("raw.png");
+    polar_io::write_gray8_png(&input, &mosaic8(16, 12)).unwrap();
+    let out = dir.path().join("o");
+    let first = run(&["stokes", p(&input), "--out", p(&out)]);
+    assert!(first.status.success(), "{}", stderr(&first));
+    assert!(out.join("mask.png").is_file());
+    let again = run(&["stokes", p(&input), "--out", p(&out), "--outputs", "dolp"]);
+    assert!(again.status.success(), "{}", stderr(&again));
+    assert!(
+        !out.join("mask.png").exists(),
+        "stale mask.png of the first run"
+    );
+    assert!(out.join("dolp.exr").is_file());
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .filter(|n| n.to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "staging left behind: {leftovers:?}");
+    let photos = dir.path().join("photos");
+    std::fs::create_dir(&photos).unwrap();
+    std::fs::write(photos.join("cat.jpg"), b"meow").unwrap();
+    fails_with(&["stokes", p(&input), "--out", p(&photos)], "did not write");
+    assert_eq!(std::fs::read(photos.join("cat.jpg")).unwrap(), b"meow");
+    assert_eq!(std::fs::read_dir(&photos).unwrap().count(), 1);
 }
 
 #[test]
@@ -320,7 +356,7 @@ fn outputs_writes_only_the_files_asked_for() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     written.sort();
-    assert_eq!(written, ["dolp.exr", "stokes.exr"]);
+    assert_eq!(written, [".polar-vision", "dolp.exr", "stokes.exr"]);
     fails_with(
         &[
             "stokes",
@@ -360,4 +396,24 @@ fn an_output_folder_inside_the_input_sample_is_refused() {
     let beside = dir.path().join("beside");
     let ok = run(&["stokes", p(&raw), "--out", p(&beside)]);
     assert!(ok.status.success(), "{}", stderr(&ok));
+}
+
+/// `--max-pixels` moves the header check's limit both ways (hostile-input issue, item 2).
+#[test]
+fn max_pixels_refuses_larger_images_from_the_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("raw.png");
+    polar_io::write_gray8_png(&input, &mosaic8(16, 12)).unwrap();
+    let out = dir.path().join("o");
+    fails_with(
+        &["stokes", p(&input), "--out", p(&out), "--max-pixels", "191"],
+        "16x12 is more than the 191 pixels",
+    );
+    assert!(!out.exists());
+    let ok = run(&["stokes", p(&input), "--out", p(&out), "--max-pixels", "192"]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    fails_with(
+        &["stokes", p(&input), "--out", p(&out), "--max-pixels", "0"],
+        "--max-pixels",
+    );
 }
