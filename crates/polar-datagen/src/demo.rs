@@ -13,7 +13,7 @@ use crate::params::{
 use crate::sample::{render, write_pictures, write_sample};
 use crate::scene::build_scene;
 use crate::store;
-use crate::suite::{FamilyKind, NoiseLevel};
+use crate::suite::{FamilyKind, NoiseLevel, validate_noise};
 
 /// A Sony IMX250MZR-like sensor in 12-bit mode: full well ~10 500 e-, read noise ~2.3 e-,
 /// extinction ratio ~300 (Sony's datasheet figures at 525 nm).
@@ -121,9 +121,24 @@ pub fn demo_params(width: u32, height: u32, spp: u32) -> SampleParams {
     }
 }
 
-/// Checks that `dir` can become a sample directory: absent, empty or an earlier sample
-/// (has meta.json), with a writable parent. Called before rendering.
+/// The last component of `--out`: the name of the sample directory (`.` or `..` name none).
+fn sample_name(dir: &Path) -> Result<String, Error> {
+    dir.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .ok_or_else(|| Error::Option {
+            option: "--out",
+            message: format!(
+                "{} does not name a sample directory; give one, e.g. --out {}",
+                dir.display(),
+                dir.join("sample").display()
+            ),
+        })
+}
+
+/// Checks that `dir` can become a sample directory: named, absent, empty or an earlier
+/// sample (has meta.json), with a writable parent. Called before rendering.
 pub fn check_sample_target(dir: &Path) -> Result<(), Error> {
+    sample_name(dir)?;
     if dir.exists() {
         let empty = std::fs::read_dir(dir)
             .map_err(Error::io(dir))?
@@ -166,25 +181,57 @@ struct SensorTable {
     extinction_ratio: Option<f64>,
 }
 
-/// The noise level of a scene file's `[sensor]` table (realistic defaults).
+/// The noise level of a scene file's `[sensor]` table (realistic defaults), checked with
+/// the rules of a suite's `[[noise]]` level; errors name the file and the key.
 pub fn noise_from_table(table: Option<&toml::Table>, file: &Path) -> Result<NoiseLevel, Error> {
     let r = realistic_noise();
     let Some(t) = table else { return Ok(r) };
-    let s: SensorTable = t
-        .clone()
-        .try_into()
-        .map_err(|e: toml::de::Error| Error::Suite {
-            path: file.to_owned(),
-            message: format!("[sensor]: {e}"),
-        })?;
-    Ok(NoiseLevel {
+    let s: SensorTable =
+        t.clone()
+            .try_into()
+            .map_err(|e: toml::de::Error| polar_render::Error::Parse {
+                file: file.to_owned(),
+                message: format!("[sensor]: {e}"),
+            })?;
+    let noise = NoiseLevel {
         name: "scene".into(),
         full_well_e: s.full_well_e.unwrap_or(r.full_well_e),
         read_noise_e: s.read_noise_e.unwrap_or(r.read_noise_e),
         bits: s.bits.unwrap_or(r.bits),
         shot_noise: s.shot_noise.unwrap_or(r.shot_noise),
         extinction_ratio: s.extinction_ratio.or(r.extinction_ratio),
-    })
+    };
+    validate_noise(&noise).map_err(|reason| polar_render::Error::Invalid {
+        file: file.to_owned(),
+        key: "sensor".into(),
+        reason,
+    })?;
+    Ok(noise)
+}
+
+/// Loads a scene file for `render`, with `--spp` and `--seed` applied, and checks everything
+/// a sample needs before any rendering: the scene, an even image size and the `[sensor]` table.
+pub fn load_render_scene(
+    file: &Path,
+    spp: Option<u32>,
+    seed: Option<u64>,
+) -> Result<(polar_render::Scene, NoiseLevel), Error> {
+    let mut scene = polar_render::load_scene(file)?;
+    let noise = noise_from_table(scene.sensor.as_ref(), file)?;
+    let c = &scene.camera;
+    for (key, v) in [("camera.width", c.width), ("camera.height", c.height)] {
+        if !v.is_multiple_of(2) {
+            return Err(polar_render::Error::Invalid {
+                file: file.to_owned(),
+                key: key.into(),
+                reason: format!("{v} must be even (the mosaic has 2x2 polarizer super-pixels)"),
+            }
+            .into());
+        }
+    }
+    scene.settings.spp = spp.unwrap_or(scene.settings.spp);
+    scene.settings.seed = seed.unwrap_or(scene.settings.seed);
+    Ok((scene, noise))
 }
 
 /// Renders `scene` into the sample directory `out`, atomically (sibling staging dir, rename).
@@ -196,17 +243,21 @@ pub fn render_into(
 ) -> Result<String, Error> {
     check_sample_target(out)?;
     let parent = parent_of(out);
-    let name = out
-        .file_name()
-        .map_or_else(|| "sample".into(), |n| n.to_string_lossy().into_owned());
+    let name = sample_name(out)?;
     let staged = parent.join(format!(".{name}.staging"));
     if staged.exists() {
         std::fs::remove_dir_all(&staged).map_err(Error::io(&staged))?;
     }
     std::fs::create_dir_all(&staged).map_err(Error::io(&staged))?;
-    let result = render(scene, &name)?;
-    write_sample(&staged, scene, &result, noise, record, &name)?;
-    write_pictures(&staged.join("pictures"), &result.stokes)?;
-    store::commit_dir(&parent, &staged, &name)?;
-    Ok(format!("{:?}", result.model))
+    let made = render(scene, &name).and_then(|result| {
+        write_sample(&staged, scene, &result, noise, record, &name)?;
+        write_pictures(&staged.join("pictures"), &result.stokes)?;
+        store::commit_dir(&parent, &staged, &name)?;
+        Ok(format!("{:?}", result.model))
+    });
+    if made.is_err() {
+        // Best effort: the error that matters is the one returned.
+        let _ = std::fs::remove_dir_all(&staged);
+    }
+    made
 }

@@ -29,6 +29,39 @@ pub enum Error {
         /// Why the probe write failed.
         source: std::io::Error,
     },
+    /// A scene file cannot be read or breaks a rule (caught before any rendering); the
+    /// renderer's error names the file and the key.
+    #[error("scene {0}")]
+    Scene(#[from] polar_render::Error),
+    /// A command-line option has a value the program cannot use.
+    #[error("{option}: {message}")]
+    Option {
+        /// The option as the user writes it, e.g. `--jobs`.
+        option: &'static str,
+        /// What is wrong with its value.
+        message: String,
+    },
+    /// The output directory holds files that are not a dataset of this program.
+    #[error(
+        "output directory {path} is not empty and is not a polar-datagen dataset (no {} or {}; it holds {found}); refusing to write into it: use a new or empty directory",
+        crate::store::RUN_RECORD,
+        crate::store::MANIFEST
+    )]
+    NotADataset {
+        /// The output directory.
+        path: PathBuf,
+        /// Some of the names found in it.
+        found: String,
+    },
+    /// Another run holds the lock of the dataset directory.
+    #[error(
+        "output directory {path} is in use by another polar-datagen run (it holds the lock file {}); wait for that run to end or use another directory",
+        path.join(crate::store::LOCK).display()
+    )]
+    Locked {
+        /// The output directory.
+        path: PathBuf,
+    },
     /// The output directory already holds a run of another suite, size or shard.
     #[error("output directory {path} holds a different run ({reason}); use a new directory")]
     RunMismatch {

@@ -4,12 +4,13 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use polar_datagen::demo::{check_sample_target, noise_from_table, run_demo};
+use polar_datagen::demo::{check_sample_target, load_render_scene, run_demo};
 use polar_datagen::progress::Progress;
-use polar_datagen::run::{RunOptions, Shard, prepare_output, run_suite};
+use polar_datagen::run::{MAX_JOBS, RunOptions, Shard, prepare_output, run_suite};
 use polar_datagen::sample::RenderWorker;
 use polar_datagen::suite::{SizeName, Suite};
 use polar_datagen::{Error, merge, store};
+use polar_render::scene::{MAX_IMAGE_SIDE, MAX_SPP};
 
 /// Make synthetic polarization-camera datasets with the polar-render path tracer.
 ///
@@ -38,8 +39,8 @@ enum Command {
         /// Image width and height in pixels (even).
         #[arg(long, default_value_t = 256, value_parser = even_size)]
         size: u32,
-        /// Samples per pixel.
-        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+        /// Samples per pixel (at most 1048576).
+        #[arg(long, default_value_t = 64, value_parser = spp_value)]
         spp: u32,
     },
     /// Render one scene file (polar-render TOML, `version = 1`) into a sample directory. The
@@ -51,8 +52,8 @@ enum Command {
         /// Output sample directory (created; an earlier sample there is replaced).
         #[arg(long)]
         out: PathBuf,
-        /// Samples per pixel, overriding the scene's.
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        /// Samples per pixel, overriding the scene's (at most 1048576).
+        #[arg(long, value_parser = spp_value)]
         spp: Option<u32>,
         /// Seed of the render and of the sensor noise, overriding the scene's.
         #[arg(long)]
@@ -73,7 +74,7 @@ enum Command {
         /// Run N jobs (e.g. a Slurm array or Kubernetes Indexed Job), then `merge` them.
         #[arg(long, default_value = "1/1")]
         shard: Shard,
-        /// Samples rendered at once (0 = one per CPU).
+        /// Samples rendered at once (0 = one per CPU; at most 1024).
         #[arg(long, default_value_t = 0)]
         jobs: usize,
         /// Which size of every family to make: `ci` (seconds) or `full`.
@@ -100,9 +101,18 @@ enum Command {
 
 fn even_size(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
-        Ok(v) if v >= 2 && v % 2 == 0 && v <= 16384 => Ok(v),
+        Ok(v) if v >= 2 && v % 2 == 0 && v as usize <= MAX_IMAGE_SIDE => Ok(v),
         _ => Err(format!(
-            "'{s}' must be an even number of pixels in 2..=16384"
+            "'{s}' must be an even number of pixels in 2..={MAX_IMAGE_SIDE}"
+        )),
+    }
+}
+
+fn spp_value(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(v) if (1..=MAX_SPP).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "'{s}' must be a number of samples in 1..={MAX_SPP}"
         )),
     }
 }
@@ -134,14 +144,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             spp,
             seed,
         } => {
-            let mut s = polar_render::load_scene(&scene).map_err(|e| Error::Suite {
-                path: scene.clone(),
-                message: e.to_string(),
-            })?;
-            let noise = noise_from_table(s.sensor.as_ref(), &scene)?;
+            let (s, noise) = load_render_scene(&scene, spp, seed)?;
             check_sample_target(&out)?;
-            s.settings.spp = spp.unwrap_or(s.settings.spp);
-            s.settings.seed = seed.unwrap_or(s.settings.seed);
             let record = serde_json::json!({ "file": scene.display().to_string(), "spp": s.settings.spp, "seed": s.settings.seed });
             let model = polar_datagen::demo::render_into(&out, &s, &noise, &record)?;
             println!("wrote {} ({model} transport)", out.display());
@@ -169,7 +173,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 Progress::Auto
             };
             let jobs = if jobs == 0 {
-                std::thread::available_parallelism().map_or(1, usize::from)
+                std::thread::available_parallelism().map_or(1, |n| usize::from(n).min(MAX_JOBS))
             } else {
                 jobs
             };
@@ -180,7 +184,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 jobs,
                 progress,
             };
-            prepare_output(&parsed, &text, &opts)?;
+            let _locked = prepare_output(&parsed, &text, &opts)?;
             let summary = run_suite(&parsed, &opts, &RenderWorker)?;
             print!("{}", summary.table());
             println!(

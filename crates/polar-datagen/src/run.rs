@@ -95,13 +95,35 @@ pub struct RunSummary {
     pub seconds: f64,
 }
 
-/// Checks the output directory and run record before any rendering; returns the record.
+/// Most samples rendered at once (`--jobs`): far above any machine's cores, low enough that
+/// the thread pool can start.
+pub const MAX_JOBS: usize = 1024;
+
+/// A dataset directory ready for [`run_suite`]: its run record, and its lock, held until this
+/// value is dropped so that no other run writes into the directory meanwhile.
+#[derive(Debug)]
+pub struct PreparedRun {
+    /// The run record of the directory.
+    pub record: RunRecord,
+    _lock: fs::File,
+}
+
+/// Checks the options and the output directory (new, empty, or a dataset of this same run),
+/// takes its lock and writes the run record, before any rendering.
 pub fn prepare_output(
     suite: &Suite,
     suite_text: &str,
     opts: &RunOptions,
-) -> Result<RunRecord, Error> {
+) -> Result<PreparedRun, Error> {
+    if !(1..=MAX_JOBS).contains(&opts.jobs) {
+        return Err(Error::Option {
+            option: "--jobs",
+            message: format!("{} must be in 1..={MAX_JOBS} (0 = one per CPU)", opts.jobs),
+        });
+    }
+    store::check_dataset_dir(&opts.out)?;
     store::ensure_writable(&opts.out)?;
+    let lock = store::lock_dataset(&opts.out)?;
     let record = RunRecord {
         suite: suite.name.clone(),
         suite_sha256: store::sha256_hex(suite_text.as_bytes()),
@@ -111,7 +133,8 @@ pub fn prepare_output(
         expected: plan_shard(suite, opts.size, opts.shard).len(),
     };
     let path = opts.out.join(store::RUN_RECORD);
-    if path.exists() {
+    let old_missing = !path.exists();
+    if !old_missing {
         let old: RunRecord = store::read_json(&path)?;
         if old != record {
             let reason = if old.suite_sha256 != record.suite_sha256 {
@@ -125,36 +148,68 @@ pub fn prepare_output(
             });
         }
     } else {
-        store::write_atomic(&opts.out.join(store::SUITE_COPY), suite_text.as_bytes())?;
         store::write_json(&path, &record)?;
     }
-    Ok(record)
+    // Written after the run record, which marks the directory as a dataset of this program.
+    let copy = opts.out.join(store::SUITE_COPY);
+    if !copy.exists() || old_missing {
+        store::write_atomic(&copy, suite_text.as_bytes())?;
+    }
+    Ok(PreparedRun {
+        record,
+        _lock: lock,
+    })
 }
 
-/// Keeps the manifest entries of this shard whose files are intact; removes staging leftovers
-/// and sample directories without a (valid) manifest entry, so they are made again.
+/// `params` as the manifest records them (serialised and read back), so that a recorded
+/// sample compares equal to its plan bit for bit.
+fn as_recorded(params: &SampleParams) -> Option<SampleParams> {
+    let text = serde_json::to_string(params).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
+/// Keeps the manifest entries of this shard whose files are intact and whose seed and
+/// parameters are the planned ones (a dataset whose run record was lost may hold samples of
+/// another suite); removes staging leftovers and the sample directories not kept, so they are
+/// made again. A directory named like a sample that this program did not write (no manifest
+/// entry, no meta.json) is an error, never deleted.
 fn recover(out: &Path, jobs: &[SampleParams]) -> Result<Vec<ManifestEntry>, Error> {
     let staging = out.join(store::STAGING);
     if staging.exists() {
         fs::remove_dir_all(&staging).map_err(Error::io(&staging))?;
     }
-    let ids: BTreeSet<&str> = jobs.iter().map(|p| p.id.as_str()).collect();
+    let planned: BTreeMap<&str, &SampleParams> = jobs.iter().map(|p| (p.id.as_str(), p)).collect();
+    let manifest = store::read_manifest(out)?;
+    let recorded: BTreeSet<&str> = manifest.iter().map(|e| e.id.as_str()).collect();
     let mut kept: Vec<ManifestEntry> = Vec::new();
-    for e in store::read_manifest(out)? {
-        let dir = out.join(&e.id);
-        let fine = ids.contains(e.id.as_str())
-            && dir.is_dir()
-            && !kept.iter().any(|k| k.id == e.id)
-            && store::verify_entry(out, &e).is_ok();
+    let mut kept_ids: BTreeSet<&str> = BTreeSet::new();
+    for e in &manifest {
+        let fine = planned
+            .get(e.id.as_str())
+            .is_some_and(|p| e.seed == p.seed && as_recorded(p).as_ref() == Some(&e.params))
+            && out.join(&e.id).is_dir()
+            && !kept_ids.contains(e.id.as_str())
+            && store::verify_entry(out, e).is_ok();
         if fine {
-            kept.push(e);
+            kept_ids.insert(&e.id);
+            kept.push(e.clone());
         }
     }
-    for id in &ids {
+    for id in planned.keys() {
         let dir = out.join(id);
-        if dir.exists() && !kept.iter().any(|k| k.id == *id) {
-            fs::remove_dir_all(&dir).map_err(Error::io(&dir))?;
+        if !dir.exists() || kept_ids.contains(id) {
+            continue;
         }
+        if !recorded.contains(id) && !dir.join("meta.json").is_file() {
+            return Err(Error::Sample {
+                id: (*id).to_owned(),
+                message: format!(
+                    "{} was not written by polar-datagen (no manifest entry, no meta.json); move it out of the dataset, it is never deleted",
+                    dir.display()
+                ),
+            });
+        }
+        fs::remove_dir_all(&dir).map_err(Error::io(&dir))?;
     }
     store::write_manifest(out, &kept)?;
     Ok(kept)
@@ -201,9 +256,9 @@ pub fn run_suite(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs.max(1))
         .build()
-        .map_err(|e| Error::Sample {
-            id: "-".into(),
-            message: format!("thread pool: {e}"),
+        .map_err(|e| Error::Option {
+            option: "--jobs",
+            message: format!("cannot start {} threads: {e}", opts.jobs),
         })?;
     pool.install(|| {
         todo.par_iter().try_for_each(|p| {

@@ -21,6 +21,9 @@ pub const RUN_RECORD: &str = "run.json";
 pub const SUITE_COPY: &str = "suite.toml";
 /// Hidden directory where samples are written before the atomic rename.
 pub const STAGING: &str = ".staging";
+/// Lock file of a dataset directory: a run holds an exclusive OS lock on it while it writes.
+/// The OS releases the lock when the process ends, even when killed; the file stays.
+pub const LOCK: &str = ".polar-datagen.lock";
 
 /// One manifest line: a committed sample.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -156,6 +159,9 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), Error> {
     write_atomic(path, format!("{text}\n").as_bytes())
 }
 
+/// The file [`ensure_writable`] creates and removes.
+const PROBE: &str = ".write-probe";
+
 /// Creates `dir` if needed and proves it writable by creating and removing a probe file.
 pub fn ensure_writable(dir: &Path) -> Result<(), Error> {
     let fail = |source| Error::OutputNotWritable {
@@ -163,9 +169,68 @@ pub fn ensure_writable(dir: &Path) -> Result<(), Error> {
         source,
     };
     fs::create_dir_all(dir).map_err(fail)?;
-    let probe = dir.join(".write-probe");
+    let probe = dir.join(PROBE);
     fs::write(&probe, b"probe").map_err(fail)?;
     fs::remove_file(&probe).map_err(fail)
+}
+
+/// Checks that `suite` may write into `dir`: absent, empty, or a dataset of this program,
+/// recognised by its run record or manifest. Anything else may hold the user's files, which a
+/// run must never overwrite or delete. What a starting run writes before its run record (the
+/// lock, the write probe, the run record's temporary file) does not count, so that a second
+/// run started at the same moment reaches the lock and says that another run holds it.
+pub fn check_dataset_dir(dir: &Path) -> Result<(), Error> {
+    if !dir.exists() || dir.join(RUN_RECORD).is_file() || dir.join(MANIFEST).is_file() {
+        return Ok(());
+    }
+    if !dir.is_dir() {
+        return Err(Error::NotADataset {
+            path: dir.to_owned(),
+            found: "a file, not a directory".into(),
+        });
+    }
+    let run_tmp = Path::new(RUN_RECORD).with_extension("tmp");
+    let starting = [Path::new(LOCK), Path::new(PROBE), &run_tmp];
+    let mut names = Vec::new();
+    for entry in fs::read_dir(dir).map_err(Error::io(dir))? {
+        let name = entry.map_err(Error::io(dir))?.file_name();
+        if !starting.contains(&Path::new(&name)) {
+            names.push(name.to_string_lossy().into_owned());
+        }
+    }
+    if names.is_empty() {
+        return Ok(());
+    }
+    names.sort();
+    let more = names.len().saturating_sub(3);
+    names.truncate(3);
+    let mut found = names.join(", ");
+    if more > 0 {
+        found.push_str(&format!(" and {more} more"));
+    }
+    Err(Error::NotADataset {
+        path: dir.to_owned(),
+        found,
+    })
+}
+
+/// Takes the exclusive lock of dataset directory `dir` (see [`LOCK`]); held until the file
+/// is dropped. Fails at once, naming the directory, when another run holds it.
+pub fn lock_dataset(dir: &Path) -> Result<fs::File, Error> {
+    let path = dir.join(LOCK);
+    let file = fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(Error::io(&path))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(fs::TryLockError::WouldBlock) => Err(Error::Locked {
+            path: dir.to_owned(),
+        }),
+        Err(fs::TryLockError::Error(e)) => Err(Error::Io { path, source: e }),
+    }
 }
 
 /// Reads the manifest's complete lines. A torn last line (the run was killed while appending)

@@ -7,12 +7,17 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use polar_render::scene::MAX_SPP;
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
 
 /// The suite file format version this crate reads.
 pub const SUITE_VERSION: u32 = 1;
+
+/// Most samples a suite may plan at one size, per family and over all families: far above
+/// real datasets, low enough that the plan (about 1 KB per sample) fits in memory.
+pub const MAX_COUNT: u32 = 1_000_000;
 
 /// A whole dataset description.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -90,6 +95,16 @@ pub enum SizeName {
     Full,
 }
 
+impl SizeName {
+    /// The key of this size in a family (`ci` or `full`).
+    pub fn key(self) -> &'static str {
+        match self {
+            SizeName::Ci => "ci",
+            SizeName::Full => "full",
+        }
+    }
+}
+
 /// Image size, sample count and samples per pixel for one size of a family.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -112,9 +127,9 @@ pub struct Family {
     pub name: String,
     /// What the family is for.
     pub kind: FamilyKind,
-    /// Names of the noise levels to cycle through; empty means all of the suite's.
-    #[serde(default)]
-    pub noise: Vec<String>,
+    /// Names of the noise levels to cycle through (at least one); absent means all of the suite's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<Vec<String>>,
     /// The CI size.
     pub ci: SizeSpec,
     /// The full size.
@@ -170,6 +185,8 @@ pub struct ParamSpec {
     pub default: [f64; 2],
     /// Hard limits: a range outside is rejected as physically implausible.
     pub limits: [f64; 2],
+    /// A count drawn as a whole number: its range must be whole numbers too.
+    pub integer: bool,
     /// What it means, with unit.
     pub doc: &'static str,
 }
@@ -192,7 +209,21 @@ const fn p(key: &'static str, default: [f64; 2], limits: [f64; 2], doc: &'static
         key,
         default,
         limits,
+        integer: false,
         doc,
+    }
+}
+
+/// An integer parameter (a count), drawn with both ends inclusive.
+const fn int(
+    key: &'static str,
+    default: [f64; 2],
+    limits: [f64; 2],
+    doc: &'static str,
+) -> ParamSpec {
+    ParamSpec {
+        integer: true,
+        ..p(key, default, limits, doc)
     }
 }
 
@@ -242,7 +273,7 @@ const COMMON: &[ParamSpec] = &[
 ];
 
 const SHAPE: &[ParamSpec] = &[
-    p(
+    int(
         "objects",
         [1.0, 3.0],
         [1.0, 8.0],
@@ -290,7 +321,7 @@ const GEOMETRY: &[ParamSpec] = &[
         [0.05, 0.9],
         "torus tube radius / ring radius",
     ),
-    p(
+    int(
         "extrusion_sides",
         [3.0, 8.0],
         [3.0, 32.0],
@@ -305,7 +336,7 @@ const GEOMETRY: &[ParamSpec] = &[
 ];
 
 const MATERIAL: &[ParamSpec] = &[
-    p(
+    int(
         "objects",
         [2.0, 4.0],
         [1.0, 8.0],
@@ -329,7 +360,7 @@ const MATERIAL: &[ParamSpec] = &[
 ];
 
 const TRANSPARENT: &[ParamSpec] = &[
-    p(
+    int(
         "objects",
         [1.0, 2.0],
         [1.0, 8.0],
@@ -413,7 +444,7 @@ const HAZE: &[ParamSpec] = &[
         [1.0, 10000.0],
         "distance of the farthest object, m",
     ),
-    p(
+    int(
         "objects",
         [3.0, 6.0],
         [1.0, 16.0],
@@ -540,6 +571,19 @@ impl Suite {
                 return Err(format!("family name '{}' is used twice", f.name));
             }
         }
+        for size in [SizeName::Ci, SizeName::Full] {
+            let total: u64 = self
+                .families
+                .iter()
+                .map(|f| u64::from(f.size(size).count))
+                .sum();
+            if total > u64::from(MAX_COUNT) {
+                return Err(format!(
+                    "the families' {}.count add up to {total} samples, more than {MAX_COUNT}",
+                    size.key()
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -552,9 +596,14 @@ impl Suite {
             return Err("name must be non-empty ASCII letters, digits, '_' or '-'".into());
         }
         for (label, s) in [("ci", f.ci), ("full", f.full)] {
-            validate_size(s).map_err(|m| format!("[{label}] {m}"))?;
+            validate_size(s).map_err(|m| format!("{label}.{m}"))?;
         }
-        for n in &f.noise {
+        if f.noise.as_ref().is_some_and(Vec::is_empty) {
+            return Err(
+                "noise = [] names no level; list at least one, or leave the key out for all".into(),
+            );
+        }
+        for n in f.noise.iter().flatten() {
             if !self.noise.iter().any(|l| &l.name == n) {
                 return Err(format!("noise level '{n}' is not defined in [[noise]]"));
             }
@@ -572,6 +621,12 @@ impl Suite {
             if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
                 return Err(format!(
                     "range {key} = [{lo}, {hi}] must be finite with min <= max"
+                ));
+            }
+            if spec.integer && (lo.fract() != 0.0 || hi.fract() != 0.0) {
+                return Err(format!(
+                    "range {key} = [{lo}, {hi}] must be whole numbers ({})",
+                    spec.doc
                 ));
             }
             let [a, b] = spec.limits;
@@ -609,12 +664,12 @@ impl Suite {
     pub fn noise_for(&self, family: &Family) -> Vec<&NoiseLevel> {
         self.noise
             .iter()
-            .filter(|l| family.noise.is_empty() || family.noise.contains(&l.name))
+            .filter(|l| family.noise.as_ref().is_none_or(|n| n.contains(&l.name)))
             .collect()
     }
 }
 
-fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
+pub(crate) fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
     if !(n.full_well_e.is_finite() && n.full_well_e >= 1.0) {
         return Err(format!(
             "full_well_e = {} must be >= 1 electron",
@@ -633,21 +688,22 @@ fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
     Ok(())
 }
 
+/// Checks one size spec; the message starts with the key (`width`, `spp`, ...).
 fn validate_size(s: SizeSpec) -> Result<(), String> {
-    if s.width < 2 || s.height < 2 || !s.width.is_multiple_of(2) || !s.height.is_multiple_of(2) {
-        return Err(format!(
-            "width x height = {}x{} must be even and >= 2 (2x2 polarizer super-pixels)",
-            s.width, s.height
-        ));
+    polar_render::scene::check_image_size(s.width as usize, s.height as usize)
+        .map_err(|(key, reason)| format!("{key}: {reason}"))?;
+    for (key, v) in [("width", s.width), ("height", s.height)] {
+        if v < 2 || !v.is_multiple_of(2) {
+            return Err(format!(
+                "{key} = {v} must be even and >= 2 (2x2 polarizer super-pixels)"
+            ));
+        }
     }
-    if s.width > 16384 || s.height > 16384 {
-        return Err(format!(
-            "width x height = {}x{} exceeds 16384",
-            s.width, s.height
-        ));
+    if !(1..=MAX_SPP).contains(&s.spp) {
+        return Err(format!("spp = {} must be in 1..={MAX_SPP}", s.spp));
     }
-    if s.spp == 0 {
-        return Err("spp must be >= 1".into());
+    if s.count > MAX_COUNT {
+        return Err(format!("count = {} exceeds {MAX_COUNT}", s.count));
     }
     Ok(())
 }
@@ -708,7 +764,68 @@ ranges = { ior = [1.4, 1.6] }
     #[test]
     fn odd_width_is_rejected() {
         let e = err_of(&MINI.replace("width = 8", "width = 7"));
-        assert!(e.contains("[ci]") && e.contains("even"), "{e}");
+        assert!(e.contains("ci.width = 7") && e.contains("even"), "{e}");
+    }
+
+    /// Issue #22: counts, sizes and spp that would exhaust memory or run for years are
+    /// refused naming the key and the bound.
+    #[test]
+    fn size_like_keys_have_upper_bounds() {
+        let cases = [
+            (
+                "count = 3",
+                "count = 1000000000",
+                "ci.count = 1000000000 exceeds 1000000",
+            ),
+            (
+                "width = 8, height = 8",
+                "width = 100000, height = 100000",
+                "ci.width: 100000 must be in 1..=16384",
+            ),
+            (
+                "width = 8, height = 8",
+                "width = 16384, height = 16384",
+                "exceeds the limit of 100000000 pixels",
+            ),
+            (
+                "spp = 1 }",
+                "spp = 4294967295 }",
+                "ci.spp = 4294967295 must be in 1..=1048576",
+            ),
+        ];
+        for (from, to, message) in cases {
+            let e = err_of(&MINI.replace(from, to));
+            assert!(e.contains("family 'sfp'") && e.contains(message), "{e}");
+        }
+        let two = format!(
+            "{MINI}{}",
+            &MINI[MINI.find("[[family]]").unwrap()..].replace("\"sfp\"", "\"b\"")
+        );
+        let big = two.replace("count = 3", "count = 600000");
+        let e = err_of(&big);
+        assert!(
+            e.contains("ci.count add up to 1200000 samples, more than 1000000"),
+            "{e}"
+        );
+        assert!(Suite::parse(&two.replace("count = 3", "count = 500000")).is_ok());
+    }
+
+    /// Issue #22: a fractional range of a count and an empty noise list are refused.
+    #[test]
+    fn fractional_counts_and_empty_noise_lists_are_rejected() {
+        let e = err_of(&MINI.replace("ior = [1.4, 1.6]", "objects = [1.5, 2.5]"));
+        assert!(
+            e.contains("range objects = [1.5, 2.5] must be whole numbers"),
+            "{e}"
+        );
+        let e = err_of(&MINI.replace("ior = [1.4, 1.6]", "extrusion_sides = [3, 4.5]"));
+        assert!(e.contains("range extrusion_sides"), "{e}");
+        assert!(Suite::parse(&MINI.replace("ior = [1.4, 1.6]", "objects = [2, 3]")).is_ok());
+        let e = err_of(&MINI.replace("kind = \"shape\"", "kind = \"shape\"\nnoise = []"));
+        assert!(
+            e.contains("family 'sfp'") && e.contains("noise = []"),
+            "{e}"
+        );
     }
 
     #[test]

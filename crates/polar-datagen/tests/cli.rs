@@ -499,3 +499,154 @@ fn haze_samples_carry_the_dehazed_view() {
         );
     }
 }
+
+/// Stderr of a run that must fail.
+fn fails(args: &[&str]) -> String {
+    let out = run(args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "{args:?} succeeded: {err}");
+    err
+}
+
+/// The names in `dir` (hidden ones too), sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Issue #22 (item 4): `suite --out` into a folder of the user's files (a `suite.toml`, a
+/// folder named like a sample with a photo) refuses before writing anything.
+#[test]
+fn suite_refuses_a_folder_that_is_not_a_dataset() {
+    let t = tempfile::tempdir().unwrap();
+    let user = t.path().join("photos");
+    std::fs::create_dir_all(user.join("sfp-00001")).unwrap();
+    std::fs::write(user.join("suite.toml"), b"mine").unwrap();
+    std::fs::write(user.join("sfp-00001/photo.jpg"), b"jpeg").unwrap();
+    let err = fails(&["suite", TINY, "--out", s(&user), "--quiet"]);
+    assert!(
+        err.contains("is not a polar-datagen dataset") && err.contains("sfp-00001, suite.toml"),
+        "{err}"
+    );
+    assert_eq!(names(&user), ["sfp-00001", "suite.toml"]);
+    assert_eq!(std::fs::read(user.join("suite.toml")).unwrap(), b"mine");
+    assert_eq!(names(&user.join("sfp-00001")), ["photo.jpg"]);
+}
+
+/// Issue #22 (item 6): while another run holds a dataset's lock, `suite` stops at once and
+/// says so; once the lock is released the same command runs.
+#[test]
+fn suite_refuses_a_dataset_another_run_holds() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("ds");
+    std::fs::create_dir(&out).unwrap();
+    let lock = polar_datagen::store::lock_dataset(&out).unwrap();
+    let err = fails(&["suite", TINY, "--out", s(&out), "--quiet"]);
+    assert!(
+        err.contains("in use by another polar-datagen run") && err.contains(".polar-datagen.lock"),
+        "{err}"
+    );
+    assert_eq!(names(&out), [".polar-datagen.lock"], "wrote while locked");
+    drop(lock);
+    run_ok(&["suite", TINY, "--out", s(&out), "--quiet"]);
+    assert_eq!(manifest_ids(&out).len(), 6);
+}
+
+/// Issue #22 (items 3 and 9): sizes that would exhaust memory or run for years, and bad
+/// options, are refused at once naming the key or option the user wrote.
+#[test]
+fn size_keys_and_options_are_bounded_and_named() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = t.path().join("big.toml");
+    let text = std::fs::read_to_string(TINY).unwrap();
+    std::fs::write(&suite, text.replacen("count = 3", "count = 1000000000", 1)).unwrap();
+    let out = t.path().join("never");
+    let err = fails(&["suite", s(&suite), "--out", s(&out)]);
+    assert!(
+        err.contains("ci.count = 1000000000 exceeds 1000000"),
+        "{err}"
+    );
+    // The suite error names the suite file once, not twice.
+    assert_eq!(err.matches("big.toml").count(), 1, "{err}");
+    let err = fails(&["suite", TINY, "--out", s(&out), "--jobs", "100000000000"]);
+    assert!(err.contains("--jobs") && err.contains("1..=1024"), "{err}");
+    let err = fails(&["demo", "--out", s(&out), "--spp", "4294967295"]);
+    assert!(
+        err.contains("--spp") && err.contains("1..=1048576"),
+        "{err}"
+    );
+    assert!(!out.exists(), "output created for refused arguments");
+
+    let scene = t.path().join("huge.toml");
+    std::fs::write(&scene, SCENE.replace("width = 16", "width = 100000")).unwrap();
+    let start = Instant::now();
+    let err = fails(&["render", s(&scene), "--out", s(&out)]);
+    assert!(
+        err.contains("`camera.width`") && err.contains("16384"),
+        "{err}"
+    );
+    assert!(
+        start.elapsed() < Duration::from_secs(30),
+        "refused only after work"
+    );
+    // A scene error names the scene file once (no "suite x.toml: x.toml:").
+    assert_eq!(err.matches("huge.toml").count(), 1, "{err}");
+    assert!(err.starts_with("polar-datagen: error: scene "), "{err}");
+}
+
+/// Issue #22 (item 9): `demo --out .` names no sample directory; it is refused naming `--out`
+/// instead of writing `./sample` while saying "wrote .".
+#[test]
+fn demo_out_must_name_a_directory() {
+    let t = tempfile::tempdir().unwrap();
+    let out = bin()
+        .current_dir(t.path())
+        .args(["demo", "--out", ".", "--size", "8", "--spp", "1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--out"), "{err}");
+    assert!(names(t.path()).is_empty(), "wrote {:?}", names(t.path()));
+}
+
+/// Issue #22 (items 8 and 9): `render` checks the image size and the `[sensor]` table before
+/// rendering, names the key the user wrote, and leaves no staging directory behind.
+#[test]
+fn render_validates_size_and_sensor_first_and_leaves_no_staging() {
+    let t = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            SCENE
+                .replace("width = 16", "width = 501")
+                .replace("height = 16", "height = 401"),
+            "`camera.width`: 501 must be even",
+        ),
+        (
+            SCENE.replace("bits = 10", "bits = 10\nfull_well_e = -100"),
+            "full_well_e = -100 must be >= 1",
+        ),
+        (
+            SCENE.replace("bits = 10", "bits = 0"),
+            "bits = 0 must be in 8..=16",
+        ),
+    ];
+    for (i, (text, message)) in cases.iter().enumerate() {
+        let scene = t.path().join(format!("scene{i}.toml"));
+        std::fs::write(&scene, text).unwrap();
+        let err = fails(&["render", s(&scene), "--out", s(&t.path().join("out"))]);
+        assert!(err.contains(message), "{err}");
+        assert!(
+            !err.contains("photons_per_unit") && !err.contains("gain"),
+            "internal name in: {err}"
+        );
+    }
+    assert_eq!(
+        names(t.path()),
+        ["scene0.toml", "scene1.toml", "scene2.toml"],
+        "left files behind"
+    );
+}

@@ -108,3 +108,74 @@ fn a_directory_of_another_run_is_refused() {
     };
     assert!(prepare_output(&suite, SUITE, &sharded).is_err());
 }
+
+fn fake() -> Fake {
+    Fake {
+        fail_on: None,
+        calls: AtomicUsize::new(0),
+    }
+}
+
+/// Issue #22 (item 7): with `run.json` gone, a resume checks every kept sample's seed and
+/// parameters against the plan: the samples of the same suite are kept, those of another
+/// suite (another seed) are made again.
+#[test]
+fn resume_without_run_record_remakes_the_samples_of_another_suite() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = Suite::parse(SUITE).unwrap();
+    let opts = options(t.path());
+    prepare_output(&suite, SUITE, &opts).unwrap();
+    run_suite(&suite, &opts, &fake()).unwrap();
+
+    std::fs::remove_file(t.path().join("run.json")).unwrap();
+    prepare_output(&suite, SUITE, &opts).unwrap();
+    let same = fake();
+    run_suite(&suite, &opts, &same).unwrap();
+    assert_eq!(
+        same.calls.load(Ordering::Relaxed),
+        0,
+        "same suite re-rendered"
+    );
+
+    std::fs::remove_file(t.path().join("run.json")).unwrap();
+    let text = SUITE.replace("seed = 7", "seed = 8");
+    let other = Suite::parse(&text).unwrap();
+    prepare_output(&other, &text, &opts).unwrap();
+    let remade = fake();
+    let summary = run_suite(&other, &opts, &remade).unwrap();
+    assert_eq!(
+        remade.calls.load(Ordering::Relaxed),
+        6,
+        "kept another suite's samples"
+    );
+    assert!(summary.families.values().all(|f| f.resumed == 0));
+    let planned = polar_datagen::run::plan(&other, SizeName::Ci);
+    let manifest = read_manifest(t.path()).unwrap();
+    for p in &planned {
+        let e = manifest.iter().find(|e| e.id == p.id).unwrap();
+        assert_eq!(e.seed, p.seed, "{}", p.id);
+        let raw = std::fs::read(t.path().join(&p.id).join("raw.png")).unwrap();
+        assert_eq!(raw, p.seed.to_le_bytes(), "{}", p.id);
+    }
+}
+
+/// Issue #22 (item 4): in a dataset, a folder named like a planned sample that this program
+/// did not write (no manifest entry, no meta.json) is an error naming it, and is kept.
+#[test]
+fn a_foreign_folder_named_like_a_sample_is_never_deleted() {
+    let t = tempfile::tempdir().unwrap();
+    let suite = Suite::parse(SUITE).unwrap();
+    let opts = options(t.path());
+    prepare_output(&suite, SUITE, &opts).unwrap();
+    std::fs::create_dir(t.path().join("sfp-00001")).unwrap();
+    std::fs::write(t.path().join("sfp-00001/photo.jpg"), b"jpeg").unwrap();
+    let err = run_suite(&suite, &opts, &fake()).unwrap_err().to_string();
+    assert!(
+        err.contains("sfp-00001") && err.contains("not written by polar-datagen"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(t.path().join("sfp-00001/photo.jpg")).unwrap(),
+        b"jpeg"
+    );
+}

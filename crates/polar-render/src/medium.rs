@@ -108,24 +108,14 @@ impl DensityGrid {
 
     /// Checks the size and the values: `Err((key under density, reason))`.
     fn validate(&self) -> Result<(), (&'static str, String)> {
-        let cells = self
-            .resolution
-            .iter()
-            .try_fold(1_usize, |acc, &n| acc.checked_mul(n));
-        if self.resolution.contains(&0) || cells.is_none() {
-            return Err((
-                "resolution",
-                format!("{:?}: every axis needs at least 1 cell", self.resolution),
-            ));
-        }
-        if cells != Some(self.values.len()) {
+        let cells = check_resolution(self.resolution).map_err(|r| ("resolution", r))?;
+        if cells != self.values.len() {
             return Err((
                 "values",
                 format!(
-                    "{} values for resolution {:?} ({} cells)",
+                    "{} values for resolution {:?} ({cells} cells)",
                     self.values.len(),
                     self.resolution,
-                    cells.unwrap_or(0)
                 ),
             ));
         }
@@ -142,6 +132,23 @@ impl DensityGrid {
         }
         Ok(())
     }
+}
+
+/// Largest density grid (cells) a scene may have: 128 MiB of values, far finer than the
+/// smooth media it describes.
+pub const MAX_DENSITY_CELLS: usize = 1 << 24;
+
+/// The number of cells of a grid `resolution`: at least 1 per axis, at most
+/// [`MAX_DENSITY_CELLS`] in all (checked without overflow).
+pub(crate) fn check_resolution(resolution: [usize; 3]) -> Result<usize, String> {
+    if resolution.contains(&0) {
+        return Err(format!("{resolution:?}: every axis needs at least 1 cell"));
+    }
+    resolution
+        .iter()
+        .try_fold(1_usize, |a, &n| a.checked_mul(n))
+        .filter(|&c| c <= MAX_DENSITY_CELLS)
+        .ok_or_else(|| format!("{resolution:?}: more than {MAX_DENSITY_CELLS} cells"))
 }
 
 impl Medium {

@@ -18,6 +18,16 @@ use std::path::Path;
 /// A 3-vector in world space.
 pub type Vec3 = Vector3<f64>;
 
+/// Largest image side in pixels a scene may ask for (the area is further bounded by
+/// [`polar_io::MAX_PIXELS`]), so a mistyped size is refused instead of exhausting memory.
+pub const MAX_IMAGE_SIDE: usize = 16384;
+/// Largest samples per pixel: far above converged renders (a few thousand), low enough that
+/// a mistyped value is refused instead of rendering for years.
+pub const MAX_SPP: u32 = 1 << 20;
+/// Largest `max_depth` (scattering events per path): Russian roulette ends paths long before
+/// it in real scenes, while a lossless scene would otherwise trace a path for hours.
+pub const MAX_PATH_DEPTH: u32 = 1024;
+
 /// Pinhole camera; `fov_deg` is the horizontal field of view (Mitsuba's
 /// default `fov_axis = "x"`). The image is `width × height`, row 0 on top.
 #[derive(Clone, Debug, PartialEq)]
@@ -269,11 +279,8 @@ impl Scene {
                 format!("must be in (0, 180), got {}", c.fov_deg),
             );
         }
-        if c.width == 0 || c.height == 0 {
-            return bad(
-                "camera.width".into(),
-                format!("image size {}x{} is empty", c.width, c.height),
-            );
+        if let Err((k, r)) = check_image_size(c.width, c.height) {
+            return bad(format!("camera.{k}"), r);
         }
         let view = c.look_at - c.position;
         if view.norm() == 0.0 || view.cross(&c.up).norm() <= 1e-9 * view.norm() * c.up.norm() {
@@ -282,11 +289,13 @@ impl Scene {
                 "look_at equals position, or up is parallel to the view direction".into(),
             );
         }
-        if self.settings.spp == 0 {
-            return bad("render.spp".into(), "must be at least 1".into());
-        }
-        if self.settings.max_depth == 0 {
-            return bad("render.max_depth".into(), "must be at least 1".into());
+        for (k, v, max) in [
+            ("render.spp", self.settings.spp, MAX_SPP),
+            ("render.max_depth", self.settings.max_depth, MAX_PATH_DEPTH),
+        ] {
+            if !(1..=max).contains(&v) {
+                return bad(k.into(), format!("{v} must be in 1..={max}"));
+            }
         }
         if self.settings.split_depth > MAX_SPLIT_DEPTH {
             return bad(
@@ -390,6 +399,27 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+/// Image width and height in `1..=`[`MAX_IMAGE_SIDE`], area at most [`polar_io::MAX_PIXELS`]:
+/// `Err((key under camera, reason))`.
+pub fn check_image_size(width: usize, height: usize) -> Result<(), (&'static str, String)> {
+    for (k, v) in [("width", width), ("height", height)] {
+        if !(1..=MAX_IMAGE_SIDE).contains(&v) {
+            return Err((k, format!("{v} must be in 1..={MAX_IMAGE_SIDE} pixels")));
+        }
+    }
+    if width * height > polar_io::MAX_PIXELS {
+        return Err((
+            "width",
+            format!(
+                "{width}x{height} = {} pixels exceeds the limit of {} pixels",
+                width * height,
+                polar_io::MAX_PIXELS
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Emission must be finite, non-negative and physical (`S1² + S2² + S3² ≤ S0²`).

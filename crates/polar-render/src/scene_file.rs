@@ -3,7 +3,7 @@
 //! errors) and every error names the file, the key and the reason.
 
 use crate::Error;
-use crate::medium::{DensityGrid, Medium, phase_key};
+use crate::medium::{DensityGrid, Medium, check_resolution, phase_key};
 use crate::sampler::SamplerKind;
 use crate::scene::{
     Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, Vec3, sky_key,
@@ -358,9 +358,6 @@ fn medium(m: MediumDesc, file: &Path) -> Result<Medium, Error> {
     })
 }
 
-/// Largest height-fog grid (cells) a scene file may ask for (128 MiB of values).
-const MAX_FOG_CELLS: usize = 1 << 24;
-
 /// The grid of `[medium.density]`: given values, or a height fog sampled on a grid.
 fn density(d: DensityDesc, lo: &Vec3, hi: &Vec3, file: &Path) -> Result<DensityGrid, Error> {
     let key = |k: &str| format!("medium.density.{k}");
@@ -395,14 +392,7 @@ fn density(d: DensityDesc, lo: &Vec3, hi: &Vec3, file: &Path) -> Result<DensityG
                 ));
             }
             if let Some(r) = d.resolution {
-                let cells = r.iter().try_fold(1_usize, |a, &n| a.checked_mul(n));
-                if r.contains(&0) || cells.is_none_or(|c| c > MAX_FOG_CELLS) {
-                    return Err(invalid(
-                        file,
-                        key("resolution"),
-                        format!("{r:?}: needs 1 to {MAX_FOG_CELLS} cells, at least 1 per axis"),
-                    ));
-                }
+                check_resolution(r).map_err(|e| invalid(file, key("resolution"), e))?;
             }
             if !(lo.iter().chain(hi.iter()).all(|c| c.is_finite())) {
                 return Err(invalid(file, "medium.bounds_min", "bounds must be finite"));
@@ -421,6 +411,10 @@ fn density(d: DensityDesc, lo: &Vec3, hi: &Vec3, file: &Path) -> Result<DensityG
         )),
     }
 }
+
+/// Largest `segments` of a tessellated shape: a 1024-segment sphere, torus or superquadric
+/// has 4.2 million triangles (about 0.2 GB of mesh), far finer than any image resolves.
+pub const MAX_SEGMENTS: u32 = 1024;
 
 /// Keys each shape type accepts besides the common ones.
 fn allowed_keys(kind: ShapeType) -> &'static [&'static str] {
@@ -479,6 +473,13 @@ fn shape(
         })
     };
     let segments = s.segments.unwrap_or(64).max(3);
+    if segments > MAX_SEGMENTS {
+        return Err(invalid(
+            file,
+            format!("{key}.segments"),
+            format!("{segments} exceeds {MAX_SEGMENTS}"),
+        ));
+    }
     let scale = match s.scale {
         None => [1.0; 3],
         Some(Scale::Uniform(k)) => [k; 3],
@@ -495,10 +496,19 @@ fn shape(
         ShapeType::Rectangle => Some(shapes::rectangle()),
         ShapeType::Cube => Some(shapes::cube()),
         ShapeType::Disk => Some(shapes::disk(segments)),
-        ShapeType::Torus => Some(shapes::torus(
-            require(s.minor_radius, "minor_radius")?,
-            segments,
-        )),
+        ShapeType::Torus => {
+            let minor = require(s.minor_radius, "minor_radius")?;
+            // At or above the major radius 1 the tube crosses the axis and the surface
+            // intersects itself.
+            if !(minor > 0.0 && minor < 1.0) {
+                return Err(invalid(
+                    file,
+                    format!("{key}.minor_radius"),
+                    format!("{minor} must be in (0, 1) (the major radius is 1)"),
+                ));
+            }
+            Some(shapes::torus(minor, segments))
+        }
         ShapeType::Superquadric => {
             let [e1, e2] = s.exponents.ok_or_else(|| {
                 invalid(

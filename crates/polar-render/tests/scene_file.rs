@@ -185,6 +185,46 @@ fn medium_keys_are_read() {
     assert!((fog.values[0] - first).abs() < 1e-12 && fog.values[63] < fog.values[0]);
 }
 
+/// Issue #22: sizes that would exhaust memory or run for years are refused before any work,
+/// naming the key and the bound.
+#[test]
+fn size_like_keys_have_upper_bounds() {
+    let sized = |w: u32, h: u32| {
+        HEADER
+            .replace("width = 16", &format!("width = {w}"))
+            .replace("height = 16", &format!("height = {h}"))
+    };
+    let big = parse_scene(&sized(100_000, 100_000), Path::new("/scenes/bad.toml")).unwrap_err();
+    assert_names(big, "camera.width", "1..=16384");
+    let area = parse_scene(&sized(16_384, 16_384), Path::new("/scenes/bad.toml")).unwrap_err();
+    assert_names(
+        area,
+        "camera.width",
+        "exceeds the limit of 100000000 pixels",
+    );
+    assert!(parse_scene(&sized(10_000, 10_000), Path::new("/scenes/bad.toml")).is_ok());
+    let err = parse("[render]\nspp = 4294967295\n").unwrap_err();
+    assert_names(err, "render.spp", "1..=1048576");
+    let err = parse("[render]\nmax_depth = 4294967295\n").unwrap_err();
+    assert_names(err, "render.max_depth", "1..=1024");
+    let err =
+        parse("[[shapes]]\ntype = \"tessellated_sphere\"\nsegments = 4000000000\n").unwrap_err();
+    assert_names(err, "shapes[0].segments", "4000000000 exceeds 1024");
+}
+
+/// Issue #22: a torus tube of negative radius, or one reaching the axis, is refused.
+#[test]
+fn torus_minor_radius_must_be_inside_the_ring() {
+    for r in ["-0.5", "0.0", "1.0", "3.0", "nan"] {
+        let err = parse(&format!(
+            "[[shapes]]\ntype = \"torus\"\nminor_radius = {r}\n"
+        ))
+        .unwrap_err();
+        assert_names(err, "shapes[0].minor_radius", "must be in (0, 1)");
+    }
+    assert!(parse("[[shapes]]\ntype = \"torus\"\nminor_radius = 0.9\n").is_ok());
+}
+
 #[test]
 fn bad_medium_values_are_named() {
     let rayleigh = "phase = { type = \"rayleigh\" }\n";
@@ -250,6 +290,13 @@ fn bad_medium_values_are_named() {
             ),
             "medium.density.resolution",
             "cells",
+        ),
+        (
+            format!(
+                "{MEDIUM}sigma_s = 1.0\n{rayleigh}density = {{ resolution = [4294967296, 4294967296, 2], values = [1.0] }}\n"
+            ),
+            "medium.density.resolution",
+            "more than 16777216 cells",
         ),
         (
             format!("{MEDIUM}sigma_s = 1.0\n{rayleigh}sigma_t = 2.0\n"),

@@ -53,9 +53,13 @@ pub fn run(args: &StokesArgs) -> Result<(), CliError> {
     write_outputs(staged.path(), &obs.planes, mask, &args.outputs)?;
     out_dir::commit(staged)?;
     let (w, h) = obs.size();
+    // A Stokes EXR is read as it is: --demosaic does not apply to it.
+    let source = match &file {
+        InputFile::Raw(_) => format!("demosaic {}", args.read.demosaic),
+        InputFile::Stokes(_) => "Stokes EXR, not demosaiced".into(),
+    };
     eprintln!(
-        "{w}x{h} ({}) in {:.1} ms, outputs in {:.1} ms -> {}",
-        args.read.demosaic,
+        "{w}x{h} ({source}) in {:.1} ms, outputs in {:.1} ms -> {}",
         computed.as_secs_f64() * 1e3,
         (start.elapsed() - computed).as_secs_f64() * 1e3,
         args.out.display()

@@ -89,10 +89,12 @@ fn sample_directory_with_raw_png_or_only_stokes_exr() {
     std::fs::create_dir(&sample).unwrap();
     polar_io::write_gray8_png(sample.join("raw.png"), &mosaic8(8, 8)).unwrap();
     let out1 = dir.path().join("o1");
+    let first = run(&["stokes", p(&sample), "--out", p(&out1)]);
+    assert!(first.status.success(), "{}", stderr(&first));
     assert!(
-        run(&["stokes", p(&sample), "--out", p(&out1)])
-            .status
-            .success()
+        stderr(&first).contains("(demosaic residual)"),
+        "{}",
+        stderr(&first)
     );
 
     // Only stokes.exr: DoLP/AoLP from it directly.
@@ -101,6 +103,12 @@ fn sample_directory_with_raw_png_or_only_stokes_exr() {
     let out2 = dir.path().join("o2");
     let out = run(&["stokes", p(&sample), "--out", p(&out2)]);
     assert!(out.status.success(), "{}", stderr(&out));
+    // Issue #22: the status line names what was read, not a demosaicing method it never ran.
+    let status = stderr(&out);
+    assert!(
+        status.contains("(Stokes EXR, not demosaiced)") && !status.contains("residual"),
+        "{status}"
+    );
     assert_eq!(
         polar_io::read_exr_channel(out1.join("dolp.exr"), "Y").unwrap(),
         polar_io::read_exr_channel(out2.join("dolp.exr"), "Y").unwrap()
