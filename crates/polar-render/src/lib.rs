@@ -29,7 +29,7 @@ pub use polar_bsdf::{Material, Polarization};
 pub use render::{RenderOptions, RenderOutput, render, required_model};
 pub use sampler::SamplerKind;
 pub use scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, TriangleMesh};
-pub use scene_file::{load_scene, parse_scene};
+pub use scene_file::{MAX_FOG_CELLS, load_scene, parse_scene};
 
 use std::path::PathBuf;
 

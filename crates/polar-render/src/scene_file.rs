@@ -359,7 +359,7 @@ fn medium(m: MediumDesc, file: &Path) -> Result<Medium, Error> {
 }
 
 /// Largest height-fog grid (cells) a scene file may ask for (128 MiB of values).
-const MAX_FOG_CELLS: usize = 1 << 24;
+pub const MAX_FOG_CELLS: usize = 1 << 24;
 
 /// The grid of `[medium.density]`: given values, or a height fog sampled on a grid.
 fn density(d: DensityDesc, lo: &Vec3, hi: &Vec3, file: &Path) -> Result<DensityGrid, Error> {
@@ -479,6 +479,13 @@ fn shape(
         })
     };
     let segments = s.segments.unwrap_or(64).max(3);
+    if segments > shapes::MAX_SEGMENTS {
+        return Err(invalid(
+            file,
+            format!("{key}.segments"),
+            format!("{segments} is more than {}", shapes::MAX_SEGMENTS),
+        ));
+    }
     let scale = match s.scale {
         None => [1.0; 3],
         Some(Scale::Uniform(k)) => [k; 3],
