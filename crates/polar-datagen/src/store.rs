@@ -242,6 +242,12 @@ pub fn read_manifest(dataset: &Path) -> Result<Vec<ManifestEntry>, Error> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(Error::Io { path, source: e }),
     };
+    parse_manifest(&path, &text)
+}
+
+/// The manifest's entries from its text, by the rules of [`read_manifest`]; `path` only
+/// names it in errors.
+pub fn parse_manifest(path: &Path, text: &str) -> Result<Vec<ManifestEntry>, Error> {
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
     let mut out = Vec::with_capacity(lines.len());
     for (i, line) in lines.iter().enumerate() {
@@ -250,7 +256,7 @@ pub fn read_manifest(dataset: &Path) -> Result<Vec<ManifestEntry>, Error> {
             Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => break,
             Err(e) => {
                 return Err(Error::Json {
-                    path,
+                    path: path.to_owned(),
                     message: format!("line {}: {e}", i + 1),
                 });
             }

@@ -43,6 +43,21 @@ pub enum Error {
         /// The limit.
         max: usize,
     },
+    /// An EXR whose pixels times channels exceed [`crate::MAX_EXR_SAMPLES`]; refused before
+    /// decoding.
+    #[error(
+        "{path}: {pixels} pixels of {channels} channels is more than the {max} samples this reader accepts"
+    )]
+    TooManySamples {
+        /// The file.
+        path: PathBuf,
+        /// Pixels in the header.
+        pixels: usize,
+        /// Channels in the header.
+        channels: usize,
+        /// The limit.
+        max: usize,
+    },
     /// The image has a colour type this reader does not accept (e.g. an RGB PNG as a mosaic).
     #[error("{path}: colour type {found}, expected {expected}")]
     ColorType {

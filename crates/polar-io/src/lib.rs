@@ -19,15 +19,18 @@ mod validate;
 
 pub use error::{Error, Result};
 pub use openexr::{
-    ExrCompression, exr_channel_names, read_exr, read_exr_channel, write_exr, write_exr_with,
+    ExrCompression, exr_channel_names, read_exr, read_exr_channel, read_exr_from, write_exr,
+    write_exr_with,
 };
 pub use png::{
-    BitDepth, GrayPng, check_mosaic_size, read_gray_png, read_gray8_png, read_mosaic,
-    read_rgb8_png, write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png,
+    BitDepth, GrayPng, check_mosaic_size, read_gray_png, read_gray_png_from, read_gray8_png,
+    read_mosaic, read_mosaic_from, read_rgb8_png, write_gray_png, write_gray8_png,
+    write_gray16_png, write_rgb8_png,
 };
 pub use sample::{
-    GroundTruth, Sample, TRANSPARENT_MASK_ON, files, material, read_ground_truth, read_json,
-    read_optional_meta, read_sample, read_sample_with, write_json, write_sample,
+    GroundTruth, Sample, TRANSPARENT_MASK_ON, files, material, parse_json, parse_meta,
+    read_ground_truth, read_json, read_optional_meta, read_sample, read_sample_with, write_json,
+    write_sample,
 };
 pub use shard::{Shard, ShardError};
 pub use staged::{StagedDir, check_replaceable};
@@ -50,6 +53,13 @@ pub fn set_max_pixels(limit: usize) {
 pub fn max_pixels() -> usize {
     PIXEL_LIMIT.load(Ordering::Relaxed)
 }
+
+/// The most samples (pixels times channels, all channels of the file counted) an EXR may
+/// have to be read at the default pixel limit: [`MAX_PIXELS`] pixels of 4 channels (a
+/// Stokes image), 1.6 GB as `f32` (4 × [`max_pixels`] when the limit is set).
+/// Every channel of a file is decoded, so without this a file of many channels could ask
+/// for any amount of memory within the pixel limit.
+pub const MAX_EXR_SAMPLES: usize = 4 * MAX_PIXELS;
 
 /// Refuses a `width × height` image of more than [`max_pixels`].
 pub(crate) fn check_pixels(path: &std::path::Path, width: usize, height: usize) -> Result<()> {

@@ -2,6 +2,8 @@
 //! Files are written single-layer, float32 scanlines (ZIP per line by default); any
 //! single-layer file (scanline or tiled, any compression, f16/f32/u32 samples) is readable.
 
+use std::fs::File;
+use std::io::{BufReader, Read, Seek};
 use std::path::Path;
 
 use exr::prelude::{
@@ -97,7 +99,17 @@ pub fn write_exr_with<const C: usize>(
 /// A channel the file lacks gives [`Error::MissingChannel`], naming the channels present.
 pub fn read_exr<const C: usize>(path: impl AsRef<Path>, names: [&str; C]) -> Result<Image<f32, C>> {
     let path = path.as_ref();
-    let layer = read_single_layer(path)?;
+    let file = File::open(path).map_err(|e| Error::io(path, "EXR", e))?;
+    read_exr_from(path, BufReader::new(file), names)
+}
+
+/// [`read_exr`] from any buffered reader (e.g. bytes in memory); `path` only names it in errors.
+pub fn read_exr_from<const C: usize>(
+    path: &Path,
+    reader: impl Read + Seek,
+    names: [&str; C],
+) -> Result<Image<f32, C>> {
+    let layer = read_single_layer(path, reader)?;
     let (width, height) = (layer.size.0, layer.size.1);
     let planes = names.map(|name| find_channel(path, &layer, name));
     let mut data = vec![0.0f32; width * height * C];
@@ -145,18 +157,25 @@ pub fn exr_channel_names(path: impl AsRef<Path>) -> Result<Vec<String>> {
 
 type AnyLayer = Layer<AnyChannels<FlatSamples>>;
 
-fn read_single_layer(path: &Path) -> Result<AnyLayer> {
-    let meta = MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
-    for header in meta.headers.iter() {
-        crate::check_pixels(path, header.layer_size.0, header.layer_size.1)?;
-    }
+fn read_single_layer(path: &Path, mut reader: impl Read + Seek) -> Result<AnyLayer> {
+    let meta = MetaData::read_from_buffered(&mut reader, false).map_err(|e| exr_error(path, e))?;
+    let [header] = meta.headers.as_slice() else {
+        return Err(Error::LayerCount {
+            path: path.to_owned(),
+            layers: meta.headers.len(),
+        });
+    };
+    let (width, height) = (header.layer_size.0, header.layer_size.1);
+    crate::check_pixels(path, width, height)?;
+    check_samples(path, width * height, header.channels.list.len())?;
+    reader.rewind().map_err(|e| Error::io(path, "EXR", e))?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .all_layers()
         .all_attributes()
-        .from_file(path)
+        .from_buffered(reader)
         .map_err(|e| exr_error(path, e))?;
     let layers = image.layer_data.len();
     match <[AnyLayer; 1]>::try_from(image.layer_data.into_vec()) {
@@ -164,6 +183,22 @@ fn read_single_layer(path: &Path) -> Result<AnyLayer> {
         Err(_) => Err(Error::LayerCount {
             path: path.to_owned(),
             layers,
+        }),
+    }
+}
+
+/// Refuses a layer of more than 4 samples per allowed pixel ([`crate::MAX_EXR_SAMPLES`]
+/// at the default limit): every channel is decoded, so the pixel limit alone would not
+/// bound memory.
+fn check_samples(path: &Path, pixels: usize, channels: usize) -> Result<()> {
+    let max = crate::max_pixels().saturating_mul(4);
+    match pixels.checked_mul(channels) {
+        Some(n) if n <= max => Ok(()),
+        _ => Err(Error::TooManySamples {
+            path: path.to_owned(),
+            pixels,
+            channels,
+            max,
         }),
     }
 }

@@ -3,7 +3,7 @@
 //! Mosaics, label maps and masks are grayscale; RGB is for visualisations only.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader, Seek};
 use std::path::Path;
 
 use polar_image::{Gray, Image};
@@ -55,23 +55,20 @@ pub struct GrayPng {
 /// 1/2/4-bit ones [`Error::BitDepth`] (their values would need rescaling to mean DN).
 pub fn read_gray_png(path: impl AsRef<Path>) -> Result<GrayPng> {
     let path = path.as_ref();
-    let d = decode(path)?;
-    if d.color != png::ColorType::Grayscale {
-        return Err(color_error(path, &d, "grayscale"));
-    }
-    let (bit_depth, data) = match d.depth {
-        png::BitDepth::Eight => (
+    read_gray_png_from(path, open(path)?)
+}
+
+/// [`read_gray_png`] from any reader (e.g. bytes in memory); `path` only names it in errors.
+pub fn read_gray_png_from(path: &Path, reader: impl BufRead + Seek) -> Result<GrayPng> {
+    let accept = |color, depth| gray_of_depth(path, color, depth, &[8, 16], "8 or 16");
+    let d = decode(path, reader, accept)?;
+    let (bit_depth, data) = if d.depth == png::BitDepth::Sixteen {
+        (BitDepth::Sixteen, u16_from_be_bytes(&d.bytes))
+    } else {
+        (
             BitDepth::Eight,
             d.bytes.into_iter().map(u16::from).collect(),
-        ),
-        png::BitDepth::Sixteen => (BitDepth::Sixteen, u16_from_be_bytes(&d.bytes)),
-        other => {
-            return Err(Error::BitDepth {
-                path: path.to_owned(),
-                found: other as u8,
-                expected: "8 or 16",
-            });
-        }
+        )
     };
     Ok(GrayPng {
         image: gray_from_vec(path, d.size, data)?,
@@ -82,25 +79,42 @@ pub fn read_gray_png(path: impl AsRef<Path>) -> Result<GrayPng> {
 /// Reads an 8-bit grayscale PNG (label maps, masks); another depth gives [`Error::BitDepth`].
 pub fn read_gray8_png(path: impl AsRef<Path>) -> Result<Gray<u8>> {
     let path = path.as_ref();
-    let d = decode(path)?;
-    if d.color != png::ColorType::Grayscale {
-        return Err(color_error(path, &d, "grayscale"));
+    let accept = |color, depth| gray_of_depth(path, color, depth, &[8], "8");
+    let d = decode(path, open(path)?, accept)?;
+    gray_from_vec(path, d.size, d.bytes)
+}
+
+/// Accepts grayscale of a bit depth in `bits` (described by `expected`).
+fn gray_of_depth(
+    path: &Path,
+    color: png::ColorType,
+    depth: png::BitDepth,
+    bits: &[u8],
+    expected: &'static str,
+) -> Result<()> {
+    if color != png::ColorType::Grayscale {
+        return Err(color_error(path, color, depth, "grayscale"));
     }
-    if d.depth != png::BitDepth::Eight {
+    if !bits.contains(&(depth as u8)) {
         return Err(Error::BitDepth {
             path: path.to_owned(),
-            found: d.depth as u8,
-            expected: "8",
+            found: depth as u8,
+            expected,
         });
     }
-    gray_from_vec(path, d.size, d.bytes)
+    Ok(())
 }
 
 /// Reads a division-of-focal-plane mosaic: an 8- or 16-bit grayscale PNG whose width and
 /// height are even and at least 2 (whole 2x2 super-pixels, layout in the conventions).
 pub fn read_mosaic(path: impl AsRef<Path>) -> Result<GrayPng> {
     let path = path.as_ref();
-    let png = read_gray_png(path)?;
+    read_mosaic_from(path, open(path)?)
+}
+
+/// [`read_mosaic`] from any reader (e.g. bytes in memory); `path` only names it in errors.
+pub fn read_mosaic_from(path: &Path, reader: impl BufRead + Seek) -> Result<GrayPng> {
+    let png = read_gray_png_from(path, reader)?;
     check_mosaic_size(path, png.image.width(), png.image.height())?;
     Ok(png)
 }
@@ -121,10 +135,14 @@ pub fn check_mosaic_size(path: &Path, width: usize, height: usize) -> Result<()>
 /// Reads an 8-bit RGB PNG (no alpha, no palette).
 pub fn read_rgb8_png(path: impl AsRef<Path>) -> Result<Image<u8, 3>> {
     let path = path.as_ref();
-    let d = decode(path)?;
-    if (d.color, d.depth) != (png::ColorType::Rgb, png::BitDepth::Eight) {
-        return Err(color_error(path, &d, "Rgb, 8-bit"));
-    }
+    let accept = |color, depth| {
+        if (color, depth) == (png::ColorType::Rgb, png::BitDepth::Eight) {
+            Ok(())
+        } else {
+            Err(color_error(path, color, depth, "Rgb, 8-bit"))
+        }
+    };
+    let d = decode(path, open(path)?, accept)?;
     Image::from_vec(d.size.0, d.size.1, d.bytes).map_err(|e| Error::corrupt(path, "PNG", e))
 }
 
@@ -209,18 +227,29 @@ fn u16_from_be_bytes(bytes: &[u8]) -> Vec<u16> {
         .collect()
 }
 
-/// Decodes a PNG without transformations (values as stored, big-endian for 16 bits), with
-/// its colour type, bit depth and `(width, height)`.
-fn decode(path: &Path) -> Result<Decoded> {
+/// The file at `path`, buffered for [`decode`].
+fn open(path: &Path) -> Result<BufReader<File>> {
     let file = File::open(path).map_err(|e| Error::io(path, "PNG", e))?;
+    Ok(BufReader::new(file))
+}
+
+/// Decodes a PNG without transformations (values as stored, big-endian for 16 bits), with
+/// its colour type, bit depth and `(width, height)`; `path` names the source in errors.
+/// `accept` judges the header's colour type and bit depth before any pixel buffer exists.
+fn decode(
+    path: &Path,
+    reader: impl BufRead + Seek,
+    accept: impl FnOnce(png::ColorType, png::BitDepth) -> Result<()>,
+) -> Result<Decoded> {
     let limits = png::Limits {
         bytes: MAX_DECODED_BYTES,
     };
-    let mut decoder = png::Decoder::new_with_limits(BufReader::new(file), limits);
+    let mut decoder = png::Decoder::new_with_limits(reader, limits);
     decoder.set_transformations(png::Transformations::IDENTITY);
     let mut reader = decoder.read_info().map_err(|e| decode_error(path, e))?;
     let info = reader.info();
     crate::check_pixels(path, info.width as usize, info.height as usize)?;
+    accept(info.color_type, info.bit_depth)?;
     let len = reader
         .output_buffer_size()
         .ok_or_else(|| Error::corrupt(path, "PNG", "image size overflows memory"))?;
@@ -230,7 +259,6 @@ fn decode(path: &Path) -> Result<Decoded> {
         .map_err(|e| decode_error(path, e))?;
     bytes.truncate(frame.buffer_size());
     Ok(Decoded {
-        color: frame.color_type,
         depth: frame.bit_depth,
         size: (frame.width as usize, frame.height as usize),
         bytes,
@@ -239,7 +267,6 @@ fn decode(path: &Path) -> Result<Decoded> {
 
 /// A decoded PNG, samples as stored.
 struct Decoded {
-    color: png::ColorType,
     depth: png::BitDepth,
     size: (usize, usize),
     bytes: Vec<u8>,
@@ -258,10 +285,15 @@ fn describe(color: png::ColorType, depth: png::BitDepth) -> String {
     format!("{color:?}, {}-bit", depth as u8)
 }
 
-fn color_error(path: &Path, d: &Decoded, expected: &'static str) -> Error {
+fn color_error(
+    path: &Path,
+    color: png::ColorType,
+    depth: png::BitDepth,
+    expected: &'static str,
+) -> Error {
     Error::ColorType {
         path: path.to_owned(),
-        found: describe(d.color, d.depth),
+        found: describe(color, depth),
         expected,
     }
 }

@@ -238,11 +238,23 @@ pub fn write_json(path: impl AsRef<Path>, value: &impl serde::Serialize) -> Resu
 pub fn read_json<T: serde::de::DeserializeOwned>(path: impl AsRef<Path>) -> Result<T> {
     let path = path.as_ref();
     let text = std::fs::read(path).map_err(|e| Error::io(path, "JSON", e))?;
-    serde_json::from_slice(&text).map_err(|e| Error::corrupt(path, "JSON", e))
+    parse_json(path, &text)
+}
+
+/// [`read_json`] of bytes already in memory; `path` only names them in errors.
+pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, bytes: &[u8]) -> Result<T> {
+    serde_json::from_slice(bytes).map_err(|e| Error::corrupt(path, "JSON", e))
 }
 
 fn read_meta(path: &Path) -> Result<Map<String, Value>> {
-    match read_json::<Value>(path)? {
+    let text = std::fs::read(path).map_err(|e| Error::io(path, "JSON", e))?;
+    parse_meta(path, &text)
+}
+
+/// The `meta.json` rule on bytes in memory: a JSON object ([`Error::MetaNotObject`] if not);
+/// `path` only names them in errors.
+pub fn parse_meta(path: &Path, bytes: &[u8]) -> Result<Map<String, Value>> {
+    match parse_json::<Value>(path, bytes)? {
         Value::Object(map) => Ok(map),
         other => Err(Error::MetaNotObject {
             path: path.to_owned(),

@@ -31,11 +31,16 @@ fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
     out
 }
 
-/// A PNG of a few dozen bytes whose header says `w x h`, 16-bit grey, with no pixel data.
-fn png_claiming(path: &Path, w: u32, h: u32) {
+/// PNG colour types (IHDR byte 9).
+const GREY: u8 = 0;
+const RGBA: u8 = 6;
+
+/// A PNG of a few dozen bytes whose header says `w x h`, 16 bits of colour type `color`,
+/// with no pixel data.
+fn png_claiming(path: &Path, w: u32, h: u32, color: u8) {
     let mut ihdr = w.to_be_bytes().to_vec();
     ihdr.extend_from_slice(&h.to_be_bytes());
-    ihdr.extend_from_slice(&[16, 0, 0, 0, 0]);
+    ihdr.extend_from_slice(&[16, color, 0, 0, 0]);
     let mut file = b"\x89PNG\r\n\x1a\n".to_vec();
     file.extend(chunk(b"IHDR", &ihdr));
     // An empty zlib stream: the decoder reads the header up to the first IDAT.
@@ -58,7 +63,7 @@ fn assert_too_large(result: Result<impl std::fmt::Debug, Error>) {
 fn tiny_png_claiming_200000_squared_pixels_is_refused_from_its_header() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("huge.png");
-    png_claiming(&path, 200_000, 200_000);
+    png_claiming(&path, 200_000, 200_000, GREY);
     assert!(std::fs::metadata(&path).unwrap().len() < 100);
     // Without the header check this aborted the process (a 40 GB allocation).
     assert_too_large(polar_io::read_mosaic(&path));
@@ -69,21 +74,70 @@ fn tiny_png_claiming_200000_squared_pixels_is_refused_from_its_header() {
 fn tiny_exr_claiming_100000_squared_pixels_is_refused_from_its_header() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("huge.exr");
-    let img = Gray::from_vec(2, 2, vec![1.0f32; 4]).unwrap();
-    polar_io::write_exr_with(&path, &img, ["Y"], polar_io::ExrCompression::None).unwrap();
-    // Patch the data window (box2i: xmin, ymin, xmax, ymax) to claim 100000 x 100000.
-    let mut bytes = std::fs::read(&path).unwrap();
-    let key = b"dataWindow\0box2i\0";
-    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
-    bytes[at + 8..at + 12].copy_from_slice(&99_999i32.to_le_bytes());
-    bytes[at + 12..at + 16].copy_from_slice(&99_999i32.to_le_bytes());
-    std::fs::write(&path, bytes).unwrap();
+    exr_claiming(&path, ["Y"], 100_000, 100_000);
     let result = polar_io::read_exr_channel(&path, "Y");
     // The exr crate may reject the inconsistent file itself; it must never allocate 40 GB.
     assert!(
         matches!(result, Err(Error::TooLarge { .. } | Error::Corrupt { .. })),
         "{result:?}"
     );
+}
+
+/// Hostile input (issue #22, seen writing the `png_mosaic` fuzz target): a colour PNG within
+/// the pixel limit was given its whole pixel buffer (800 MB for 100 MP of 16-bit RGBA) before
+/// its colour type was refused; now the header's colour type is judged first.
+#[test]
+fn tiny_colour_png_is_refused_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rgba.png");
+    png_claiming(&path, 10_000, 10_000, RGBA);
+    for result in [
+        polar_io::read_mosaic(&path).map(|_| ()),
+        polar_io::read_gray8_png(&path).map(|_| ()),
+        polar_io::read_rgb8_png(&path).map(|_| ()),
+    ] {
+        match result {
+            Err(Error::ColorType { found, .. }) => assert_eq!(found, "Rgba, 16-bit"),
+            other => panic!("expected ColorType, got {other:?}"),
+        }
+    }
+}
+
+/// A 2x2 float EXR of `C` channels whose data window is patched to claim `w x h` pixels.
+fn exr_claiming<const C: usize>(path: &Path, names: [&str; C], w: i32, h: i32) {
+    let img = polar_image::Image::<f32, C>::from_vec(2, 2, vec![1.0f32; 4 * C]).unwrap();
+    polar_io::write_exr_with(path, &img, names, polar_io::ExrCompression::None).unwrap();
+    // The data window is a box2i: xmin, ymin, xmax, ymax.
+    let mut bytes = std::fs::read(path).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    bytes[at + 8..at + 12].copy_from_slice(&(w - 1).to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&(h - 1).to_le_bytes());
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// Hostile input (issue #22, seen writing the `exr_stokes` fuzz target): every channel of
+/// an EXR is decoded, so a file of many channels within the pixel limit could ask for any
+/// amount of memory; pixels times channels above `MAX_EXR_SAMPLES` are now refused from the
+/// header.
+#[test]
+fn tiny_exr_of_many_channels_is_refused_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("wide.exr");
+    let names = ["A", "B", "C", "D", "E"];
+    exr_claiming(&path, names, 10_000, 10_000);
+    match polar_io::read_exr(&path, ["A"]) {
+        Err(Error::TooManySamples {
+            pixels,
+            channels,
+            max,
+            ..
+        }) => {
+            assert_eq!((pixels, channels), (MAX_PIXELS, 5));
+            assert_eq!(max, polar_io::MAX_EXR_SAMPLES);
+        }
+        other => panic!("expected TooManySamples, got {other:?}"),
+    }
 }
 
 #[test]

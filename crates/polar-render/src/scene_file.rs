@@ -412,10 +412,6 @@ fn density(d: DensityDesc, lo: &Vec3, hi: &Vec3, file: &Path) -> Result<DensityG
     }
 }
 
-/// Largest `segments` of a tessellated shape: a 1024-segment sphere, torus or superquadric
-/// has 4.2 million triangles (about 0.2 GB of mesh), far finer than any image resolves.
-pub const MAX_SEGMENTS: u32 = 1024;
-
 /// Keys each shape type accepts besides the common ones.
 fn allowed_keys(kind: ShapeType) -> &'static [&'static str] {
     const PLACED: [&str; 3] = ["translate", "rotate_deg", "scale"];
@@ -473,11 +469,11 @@ fn shape(
         })
     };
     let segments = s.segments.unwrap_or(64).max(3);
-    if segments > MAX_SEGMENTS {
+    if segments > shapes::MAX_SEGMENTS {
         return Err(invalid(
             file,
             format!("{key}.segments"),
-            format!("{segments} exceeds {MAX_SEGMENTS}"),
+            format!("{segments} is more than {}", shapes::MAX_SEGMENTS),
         ));
     }
     let scale = match s.scale {

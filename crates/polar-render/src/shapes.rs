@@ -71,6 +71,12 @@ pub fn disk(segments: u32) -> TriangleMesh {
     }
 }
 
+/// Most `segments` a scene file may give a built-in shape: a 1024-segment sphere has 4 M
+/// triangles (about 180 MB with its vertices), finer than any pixel of a 4K render needs,
+/// while a larger count would let a few bytes of scene text exhaust memory (and `2 *
+/// segments` overflow `u32`).
+pub const MAX_SEGMENTS: u32 = 1024;
+
 /// A smooth-shaded grid mesh over `(u, v) ∈ [0, 1]²` from a parametric surface
 /// returning `(position, normal)`; `closed_u` joins the seam at `u = 1`.
 fn parametric(nu: u32, nv: u32, f: impl Fn(f64, f64) -> (Vec3, Vec3)) -> TriangleMesh {

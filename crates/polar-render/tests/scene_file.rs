@@ -358,3 +358,17 @@ fn sky_light_is_read_and_checked() {
     let zero = sky.replace("[1.0, 1.0, 0.0]", "[0.0, 0.0, 0.0]");
     assert_names(parse(&zero).unwrap_err(), "lights[0].sun_direction", "unit");
 }
+
+/// Hostile input (issue #22, seen writing the `scene` fuzz target): `segments` near `u32::MAX` overflowed `2 * segments`
+/// and asked for far more memory than exists; above `MAX_SEGMENTS` it is now refused.
+#[test]
+fn segments_above_the_limit_are_rejected() {
+    let max = polar_render::shapes::MAX_SEGMENTS;
+    for segments in [max + 1, u32::MAX] {
+        let body =
+            format!("[[shapes]]\ntype = \"torus\"\nminor_radius = 0.3\nsegments = {segments}\n");
+        let err = parse(&body).unwrap_err();
+        assert_names(err, "shapes[0].segments", &format!("more than {max}"));
+    }
+    assert!(parse("[[shapes]]\ntype = \"disk\"\nsegments = 3\n").is_ok());
+}

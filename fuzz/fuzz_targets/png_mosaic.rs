@@ -1,0 +1,9 @@
+//! Fuzz target `png_mosaic`: see `harness::PNG_MOSAIC`.
+
+#![no_main]
+
+#[allow(dead_code)] // each target uses one harness
+#[path = "../harness.rs"]
+mod harness;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| harness::check(&harness::PNG_MOSAIC, data));
