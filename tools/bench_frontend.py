@@ -14,13 +14,22 @@ before and after) are printed with the table.
 The Rust side also measures memory bandwidth (memcpy and a STREAM-scale loop) and
 reports the fused chain against the bytes it must move.
 
-Usage: tools/.venv/bin/python tools/bench_frontend.py [FRAME.png] [--reps N]
+Whole process (`--process N`): `polar-vision stokes FRAME --out DIR` spawned as a user
+runs it (release build), median of N runs, with the default `residual` and with
+`--demosaic bilinear`, in the same run as polanalyser's chain; reports the split the
+program prints (compute = read + demosaic + products, outputs), the bytes its outputs
+take on disk and its peak resident memory per input pixel (from wait4's ru_maxrss).
+
+Usage: tools/.venv/bin/python tools/bench_frontend.py [FRAME.png] [--reps N] [--process N]
 """
 
 import argparse
 import json
 import os
+import re
+import statistics
 import subprocess
+import tempfile
 import time
 from pathlib import Path
 
@@ -50,10 +59,47 @@ def polanalyser_chain(raw, muellers):
     return stokes, dolp, aolp
 
 
+def run_process(exe, frame, extra):
+    """One `polar-vision stokes` run into a fresh folder: (wall s, stderr split line,
+    output bytes on disk, peak RSS in bytes)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "out"
+        t = time.perf_counter()
+        proc = subprocess.Popen([str(exe), "stokes", frame, "--out", str(out), *extra], stderr=subprocess.PIPE, text=True)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t
+        err = proc.stderr.read()
+        if os.waitstatus_to_exitcode(status) != 0:
+            raise SystemExit(f"polar-vision stokes {frame} {' '.join(extra)} failed:\n{err}")
+        size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
+    split = re.search(r"in ([0-9.]+) ms, outputs in ([0-9.]+) ms", err)
+    return wall, split.groups() if split else ("?", "?"), size, usage.ru_maxrss * 1024
+
+
+def process_table(frame, runs, t_py, pixels):
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    subprocess.run(["cargo", "build", "--release", "--locked", "-p", "polar-vision"], cwd=ROOT, check=True, stderr=subprocess.DEVNULL)
+    exe = target / "release" / "polar-vision"
+    print()
+    print(f"Whole process, median of {runs} runs (polanalyser compute {t_py * 1e3:.0f} ms in this run):")
+    print(f"| {'command':<44} | {'wall ms':>8} | {'vs polanalyser':>14} | {'compute / outputs ms':>20} | {'MB on disk':>10} | {'peak B/px':>9} |")
+    print(f"|{'-' * 46}|{'-' * 10}|{'-' * 16}|{'-' * 22}|{'-' * 12}|{'-' * 11}|")
+    for label, extra in [("stokes (default: residual)", []), ("stokes --demosaic bilinear", ["--demosaic", "bilinear"])]:
+        rs = [run_process(exe, frame, extra) for _ in range(runs)]
+        wall = statistics.median(r[0] for r in rs)
+        mid = min(rs, key=lambda r: abs(r[0] - wall))
+        peak = max(r[3] for r in rs)
+        print(
+            f"| {label:<44} | {wall * 1e3:8.0f} | {t_py / wall:13.2f}x | {mid[1][0]:>9} / {mid[1][1]:>8} | "
+            f"{mid[2] / 1e6:10.1f} | {peak / pixels:9.1f} |"
+        )
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("frame", nargs="?", default=str(ROOT / "tests/data/real/carps_IMX250MZR.png"))
     parser.add_argument("--reps", type=int, default=10)
+    parser.add_argument("--process", type=int, default=0, metavar="N", help="also time the whole polar-vision stokes process, median of N runs")
     args = parser.parse_args()
 
     raw = cv2.imread(args.frame, cv2.IMREAD_UNCHANGED)
@@ -107,6 +153,8 @@ def main():
             bound = f"{t / rs['bound_s']:7.2f}x" if name == "bilinear" else f"{'-':>8}"
             pipeline = f"polar-sensor {name} -> S0,S1,S2,DoLP,AoLP (f32)"
             print(f"| {pipeline:<52} | {label:<22} | {t * 1e3:8.2f} | {t_py / t:13.1f}x | {bound} |")
+    if args.process:
+        process_table(args.frame, args.process, t_py, w * h)
 
 if __name__ == "__main__":
     main()

@@ -20,7 +20,7 @@ mod validate;
 pub use error::{Error, Result};
 pub use openexr::{
     ExrCompression, exr_channel_names, read_exr, read_exr_channel, read_exr_from, write_exr,
-    write_exr_with,
+    write_exr_planes3, write_exr_with,
 };
 pub use png::{
     BitDepth, GrayPng, check_mosaic_size, read_gray_png, read_gray_png_from, read_gray8_png,

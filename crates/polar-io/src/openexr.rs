@@ -8,7 +8,8 @@ use std::path::Path;
 
 use exr::prelude::{
     AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Layer, LayerAttributes,
-    LineOrder, MetaData, ReadChannels, ReadLayers, Text, WritableImage, read,
+    LineOrder, MetaData, ReadChannels, ReadLayers, SpecificChannels, Text, Vec2, WritableImage,
+    read,
 };
 use polar_image::{Gray, Image};
 
@@ -85,6 +86,60 @@ pub fn write_exr_with<const C: usize>(
         LayerAttributes::default(),
         compression.encoding(),
         AnyChannels::sort(channels.into()),
+    );
+    let exr_image = exr::prelude::Image::from_layer(layer);
+    write_file_atomic(path, |writer| {
+        exr_image
+            .write()
+            .to_buffered(writer)
+            .map_err(|e| exr_error(path, e))
+    })
+}
+
+/// Writes three planes of one size as the float32 channels `names` of a single-layer EXR,
+/// atomically: the encoder reads the planes in place, block by block, so no interleaved
+/// or per-channel copy of the image is made (the file equals [`write_exr_with`]'s of the
+/// same pixels).
+pub fn write_exr_planes3(
+    path: impl AsRef<Path>,
+    planes: [&Gray<f32>; 3],
+    names: [&str; 3],
+    compression: ExrCompression,
+) -> Result<()> {
+    let path = path.as_ref();
+    let [a, b, c] = channel_texts(path, &names)?
+        .try_into()
+        .expect("three names give three texts");
+    let (width, height) = planes[0].size();
+    if width == 0 || height == 0 {
+        return Err(Error::Dimensions {
+            path: path.to_owned(),
+            width,
+            height,
+        });
+    }
+    if let Some(p) = planes.iter().find(|p| p.size() != (width, height)) {
+        return Err(Error::SizeMismatch {
+            path: path.to_owned(),
+            found: p.size(),
+            expected: (width, height),
+            reference: path.to_owned(),
+        });
+    }
+    let [pa, pb, pc] = planes.map(|p| p.as_slice());
+    let channels = SpecificChannels::build()
+        .with_channel(a)
+        .with_channel(b)
+        .with_channel(c)
+        .with_pixel_fn(|pos: Vec2<usize>| {
+            let k = pos.y() * width + pos.x();
+            (pa[k], pb[k], pc[k])
+        });
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        compression.encoding(),
+        channels,
     );
     let exr_image = exr::prelude::Image::from_layer(layer);
     write_file_atomic(path, |writer| {

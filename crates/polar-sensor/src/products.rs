@@ -20,6 +20,7 @@ use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
 
 use crate::demosaic::bilinear::bilinear_stokes_row;
+use crate::demosaic::residual::{ResidualRow, StokesRow, guide_and_residual};
 use crate::demosaic::{DemosaicMethod, demosaic};
 use crate::fastmath::dolp_aolp_row;
 use crate::layout::{Mosaic, MosaicSample};
@@ -251,12 +252,47 @@ pub fn stokes_planes_into<T: MosaicSample>(
             got_height,
         });
     }
-    if method != DemosaicMethod::Bilinear || w < 4 || h < 4 {
-        *out = StokesPlanes::from_stack(&demosaic(raw, method)?);
-        return Ok(());
+    match method {
+        DemosaicMethod::Bilinear if w >= 4 && h >= 4 => {
+            fused_bilinear(raw.as_slice(), w, h, out, Arch::new())
+        }
+        DemosaicMethod::Residual => fused_residual(raw.as_slice(), w, h, out, Arch::new()),
+        _ => *out = StokesPlanes::from_stack(&demosaic(raw, method)?),
     }
-    fused_bilinear(raw.as_slice(), w, h, out, Arch::new());
     Ok(())
+}
+
+/// The fused residual chain: the guide and the residual go into the DoLP and AoLP planes
+/// (scratch until the last pass), then each row is interpolated straight into `S0, S1,
+/// S2`, then DoLP and AoLP are derived; so no full-size temporary is allocated.
+fn fused_residual<T: MosaicSample>(
+    src: &[T],
+    w: usize,
+    h: usize,
+    out: &mut StokesPlanes,
+    arch: Arch,
+) {
+    let (guide, res) = (out.dolp.as_mut_slice(), out.aolp.as_mut_slice());
+    guide_and_residual(src, w, h, guide, res);
+    let (guide, res) = (out.dolp.as_slice(), out.aolp.as_slice());
+    let [s0, s1, s2] = [&mut out.s0, &mut out.s1, &mut out.s2].map(|p| p.as_mut_slice());
+    s0.par_chunks_mut(w)
+        .zip(s1.par_chunks_mut(w))
+        .zip(s2.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, ((a, b), c))| {
+            arch.dispatch(ResidualRow {
+                src,
+                guide,
+                res,
+                w,
+                h,
+                y,
+                sink: StokesRow([a, b, c]),
+            })
+        });
+    out.rows_mut()
+        .for_each(|[s0, s1, s2, d, a]| derived_row(s0, s1, s2, d, a));
 }
 
 /// The fused bilinear chain on planes of the mosaic size (`w, h >= 4`), one rayon task

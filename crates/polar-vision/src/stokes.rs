@@ -109,8 +109,8 @@ pub fn write_outputs(
     let mut jobs: Vec<Job<'_>> = Vec::new();
     if want(Output::Stokes) {
         jobs.push(Box::new(move || {
-            let img = planes.linear_stokes();
-            polar_io::write_exr_with(out.join(vision::STOKES), &img, LINEAR_STOKES_CHANNELS, rle)
+            let s = [&planes.s0, &planes.s1, &planes.s2];
+            polar_io::write_exr_planes3(out.join(vision::STOKES), s, LINEAR_STOKES_CHANNELS, rle)
         }));
     }
     if want(Output::Dolp) {
