@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use polar_render::Polarization;
 use serde::Deserialize;
 
 use crate::Error;
@@ -147,11 +148,15 @@ fn parent_of(dir: &Path) -> PathBuf {
         .map_or_else(|| PathBuf::from("."), Path::to_owned)
 }
 
-/// Renders the demo into `out` (a sample directory with `pictures/`); returns the model name.
-pub fn run_demo(out: &Path, width: u32, height: u32, spp: u32) -> Result<String, Error> {
+/// Renders the demo into `out` (a sample directory with `pictures/`); returns the transport
+/// model used.
+pub fn run_demo(out: &Path, width: u32, height: u32, spp: u32) -> Result<Polarization, Error> {
     let params = demo_params(width, height, spp);
     let scene = build_scene(&params);
-    let record = serde_json::to_value(&params).unwrap_or_default();
+    let record = serde_json::to_value(&params).map_err(|e| Error::Sample {
+        id: params.id.clone(),
+        message: format!("parameters to JSON: {e}"),
+    })?;
     render_into(out, &scene, &params.noise, &record)
 }
 
@@ -173,9 +178,9 @@ pub fn noise_from_table(table: Option<&toml::Table>, file: &Path) -> Result<Nois
     let s: SensorTable = t
         .clone()
         .try_into()
-        .map_err(|e: toml::de::Error| Error::Suite {
+        .map_err(|e: toml::de::Error| Error::SceneSensor {
             path: file.to_owned(),
-            message: format!("[sensor]: {e}"),
+            message: e.to_string(),
         })?;
     Ok(NoiseLevel {
         name: "scene".into(),
@@ -193,7 +198,7 @@ pub fn render_into(
     scene: &polar_render::Scene,
     noise: &NoiseLevel,
     record: &serde_json::Value,
-) -> Result<String, Error> {
+) -> Result<Polarization, Error> {
     check_sample_target(out)?;
     let parent = parent_of(out);
     let name = out
@@ -208,5 +213,5 @@ pub fn render_into(
     write_sample(&staged, scene, &result, noise, record, &name)?;
     write_pictures(&staged.join("pictures"), &result.stokes)?;
     store::commit_dir(&parent, &staged, &name)?;
-    Ok(format!("{:?}", result.model))
+    Ok(result.model)
 }

@@ -21,6 +21,17 @@ pub enum Error {
         /// What is wrong and where.
         message: String,
     },
+    /// The scene file of `render` cannot be loaded (the message names the file and key).
+    #[error("scene {0}")]
+    Scene(#[from] polar_render::Error),
+    /// The `[sensor]` table of a scene file is invalid.
+    #[error("scene {path}: [sensor]: {message}")]
+    SceneSensor {
+        /// The scene file.
+        path: PathBuf,
+        /// What is wrong and where.
+        message: String,
+    },
     /// The output directory cannot be created or written.
     #[error("output directory {path} is not writable: {source}")]
     OutputNotWritable {

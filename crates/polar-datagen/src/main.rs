@@ -122,7 +122,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Demo { out, size, spp } => {
             let model = run_demo(&out, size, size, spp)?;
             println!(
-                "wrote {} ({model} transport); pictures in {}",
+                "wrote {} ({model:?} transport); pictures in {}",
                 out.display(),
                 out.join("pictures").display()
             );
@@ -134,17 +134,14 @@ fn run(cli: Cli) -> Result<(), Error> {
             spp,
             seed,
         } => {
-            let mut s = polar_render::load_scene(&scene).map_err(|e| Error::Suite {
-                path: scene.clone(),
-                message: e.to_string(),
-            })?;
+            let mut s = polar_render::load_scene(&scene)?;
             let noise = noise_from_table(s.sensor.as_ref(), &scene)?;
             check_sample_target(&out)?;
             s.settings.spp = spp.unwrap_or(s.settings.spp);
             s.settings.seed = seed.unwrap_or(s.settings.seed);
             let record = serde_json::json!({ "file": scene.display().to_string(), "spp": s.settings.spp, "seed": s.settings.seed });
             let model = polar_datagen::demo::render_into(&out, &s, &noise, &record)?;
-            println!("wrote {} ({model} transport)", out.display());
+            println!("wrote {} ({model:?} transport)", out.display());
             Ok(())
         }
         Command::Suite {

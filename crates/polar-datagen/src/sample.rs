@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use polar_image::{Gray, Image, StokesImage};
-use polar_render::{RenderOptions, RenderOutput, Scene};
+use polar_render::{Polarization, RenderOptions, RenderOutput, Scene};
 use polar_sensor::SensorModel;
 use serde::Serialize;
 
@@ -27,19 +27,23 @@ impl SampleWorker for RenderWorker {
     fn produce(&self, params: &SampleParams, dir: &Path) -> Result<WorkReport, Error> {
         let scene = build_scene(params);
         let out = render(&scene, &params.id)?;
-        let record = serde_json::to_value(params).unwrap_or_default();
+        let record = serde_json::to_value(params).map_err(|e| Error::Sample {
+            id: params.id.clone(),
+            message: format!("parameters to JSON: {e}"),
+        })?;
         write_sample(dir, &scene, &out, &params.noise, &record, &params.id)?;
         Ok(WorkReport {
-            model: format!("{:?}", out.model),
+            model: out.model,
             render_seconds: out.seconds,
         })
     }
 }
 
-/// Renders a scene (with a medium also its dehazed ground truth, see
-/// [`RenderOutput::dehazed`]), mapping errors to the sample id.
+/// Renders a scene (with a medium also its clear and dehazed ground truth, see
+/// [`RenderOutput::clear`] and [`RenderOutput::dehazed`]), mapping errors to the sample id.
 pub fn render(scene: &Scene, id: &str) -> Result<RenderOutput, Error> {
     let opts = RenderOptions {
+        clear: true,
         dehazed: true,
         ..RenderOptions::default()
     };
@@ -89,7 +93,7 @@ struct Meta<'a> {
 #[derive(Serialize)]
 struct RendererMeta {
     name: &'static str,
-    model: String,
+    model: Polarization,
     spp: u32,
     max_depth: u32,
     split_depth: u32,
@@ -205,7 +209,7 @@ fn meta<'a>(
         generator: format!("polar-datagen {}", env!("CARGO_PKG_VERSION")),
         renderer: RendererMeta {
             name: "polar-render",
-            model: format!("{:?}", out.model),
+            model: out.model,
             spp: out.spp,
             max_depth: s.settings.max_depth,
             split_depth: s.settings.split_depth,

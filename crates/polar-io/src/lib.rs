@@ -23,7 +23,7 @@ pub use png::{
     read_rgb8_png, write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png,
 };
 pub use sample::{
-    GroundTruth, Sample, TRANSPARENT_MASK_ON, files, material, read_ground_truth, read_json,
+    GroundTruth, MaterialLabel, Sample, TRANSPARENT_MASK_ON, files, read_ground_truth, read_json,
     read_optional_meta, read_sample, read_sample_with, write_json, write_sample,
 };
 pub use shard::{Shard, ShardError};
