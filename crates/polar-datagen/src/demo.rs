@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use polar_render::Polarization;
+use polar_sensor::SensorModel;
 use serde::Deserialize;
 
 use crate::Error;
@@ -16,16 +17,16 @@ use crate::scene::build_scene;
 use crate::store;
 use crate::suite::{FamilyKind, NoiseLevel};
 
-/// A Sony IMX250MZR-like sensor in 12-bit mode: full well ~10 500 e-, read noise ~2.3 e-,
-/// extinction ratio ~300 (Sony's datasheet figures at 525 nm).
+/// The noise of the Sony IMX250MZR preset ([`SensorModel::imx250mzr`]).
 pub fn realistic_noise() -> NoiseLevel {
+    let p = SensorModel::imx250mzr();
     NoiseLevel {
         name: "realistic".into(),
-        full_well_e: 10_500.0,
-        read_noise_e: 2.3,
-        bits: 12,
-        shot_noise: true,
-        extinction_ratio: Some(300.0),
+        full_well_e: p.full_well,
+        read_noise_e: p.read_noise,
+        bits: u8::try_from(p.bit_depth).expect("the preset's bit depth is at most 16"),
+        shot_noise: p.shot_noise,
+        extinction_ratio: Some(p.extinction_ratio),
     }
 }
 

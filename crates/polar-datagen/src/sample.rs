@@ -53,20 +53,22 @@ pub fn render(scene: &Scene, id: &str) -> Result<RenderOutput, Error> {
     })
 }
 
-/// The sensor of a noise level with auto-exposure for `stokes`, seeded by `seed`.
+/// The sensor of a noise level with auto-exposure for `stokes`, seeded by `seed`: the
+/// quantum efficiency of [`SensorModel::imx250mzr`], the rest from the noise level.
 pub fn sensor_model(noise: &NoiseLevel, stokes: &StokesImage, seed: u64) -> SensorModel {
+    let quantum_efficiency = SensorModel::imx250mzr().quantum_efficiency;
     let max_dn = f64::from((1u32 << noise.bits) - 1);
     let s0 = stokes.channel(0);
     let level = polar_sensor::picture::quantile(&s0, EXPOSURE_QUANTILE).map_or(0.0, f64::from);
-    let photons_per_unit = if level > 0.0 {
+    let electrons_per_unit = if level > 0.0 {
         EXPOSURE_TARGET * noise.full_well_e / level
     } else {
         1.0
     };
     SensorModel {
-        photons_per_unit,
+        photons_per_unit: electrons_per_unit / quantum_efficiency,
         extinction_ratio: noise.extinction_ratio.unwrap_or(f64::INFINITY),
-        quantum_efficiency: 1.0,
+        quantum_efficiency,
         gain: noise.full_well_e / max_dn,
         read_noise: noise.read_noise_e,
         full_well: noise.full_well_e,
@@ -104,6 +106,7 @@ struct RendererMeta {
 struct SensorMeta<'a> {
     noise: &'a NoiseLevel,
     photons_per_unit: f64,
+    quantum_efficiency: f64,
     gain_e_per_dn: f64,
     bit_depth: u32,
     black_level: u16,
@@ -218,6 +221,7 @@ fn meta<'a>(
         sensor: SensorMeta {
             noise,
             photons_per_unit: model.photons_per_unit,
+            quantum_efficiency: model.quantum_efficiency,
             gain_e_per_dn: model.gain,
             bit_depth: model.bit_depth,
             black_level: model.black_level,
