@@ -57,7 +57,9 @@ use polar_optics::{Mueller, Stokes};
 
 /// The cheapest exact light-transport model a BSDF needs, ordered
 /// `None < Linear < Full` so a scene needs the maximum over its materials.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub enum Polarization {
     /// Never polarizes and passes light on depolarized (only `M00` is non-zero):
     /// scalar transport is exact.
@@ -230,5 +232,15 @@ impl Bsdf {
     /// The cheapest exact transport model this BSDF needs.
     pub fn polarization(&self) -> Polarization {
         with_model!(self, m => m.polarization())
+    }
+
+    /// Whether the surface looks the same from both sides (opaque models): a renderer
+    /// shades it with the normal facing the viewer. Transmissive models (dielectric,
+    /// sheets) are one-sided: the normal's orientation tells inside from outside.
+    pub fn is_two_sided(&self) -> bool {
+        match self {
+            Bsdf::Lambertian(_) | Bsdf::Conductor(_) | Bsdf::Plastic(_) => true,
+            Bsdf::Dielectric(_) | Bsdf::Sheet(_) => false,
+        }
     }
 }

@@ -366,15 +366,6 @@ impl Material {
         }
     }
 
-    /// Ground-truth label per the conventions: 1 opaque dielectric, 2 metal, 3 transparent.
-    pub fn label(&self) -> u8 {
-        match self {
-            Material::Lambertian(_) | Material::Plastic(_) => 1,
-            Material::Conductor(_) => 2,
-            Material::Dielectric(_) | Material::Polarizer(_) | Material::Retarder(_) => 3,
-        }
-    }
-
     /// Whether [`Self::bsdf`] depends on `uv` (a textured albedo); if not, a renderer
     /// need not compute surface coordinates.
     pub fn uses_uv(&self) -> bool {

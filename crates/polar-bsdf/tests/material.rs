@@ -17,37 +17,41 @@ fn invalid_field(text: &str) -> &'static str {
 #[test]
 fn every_material_parses_validates_and_builds() {
     let cases = [
-        ("type = 'lambertian'\nalbedo = 0.5", 1),
+        ("type = 'lambertian'\nalbedo = 0.5", true),
         (
             "type = 'lambertian'\nalbedo = { checkerboard = [0.2, 0.8], scale = 4.0 }",
-            1,
+            true,
         ),
-        ("type = 'conductor'\nmetal = 'au'", 2),
+        ("type = 'conductor'\nmetal = 'au'", true),
         (
             "type = 'conductor'\nmetal = 'Cu'\nroughness = [0.05, 0.3]",
-            2,
+            true,
         ),
-        ("type = 'conductor'\nn = 0.2\nk = 3.0\nroughness = 0.1", 2),
-        ("type = 'dielectric'\nior = 1.5", 3),
+        (
+            "type = 'conductor'\nn = 0.2\nk = 3.0\nroughness = 0.1",
+            true,
+        ),
+        ("type = 'dielectric'\nior = 1.5", false),
         (
             "type = 'dielectric'\nior = 1.33\next_ior = 1.0\nroughness = 0.2",
-            3,
+            false,
         ),
-        ("type = 'plastic'", 1),
+        ("type = 'plastic'", true),
         (
             "type = 'plastic'\nalbedo = 0.3\nior = 1.5\nroughness = 0.0",
-            1,
+            true,
         ),
-        ("type = 'polarizer'\nangle_deg = 30.0", 3),
+        ("type = 'polarizer'\nangle_deg = 30.0", false),
         (
             "type = 'retarder'\nangle_deg = 45.0\nretardance_deg = 90.0",
-            3,
+            false,
         ),
     ];
-    for (text, label) in cases {
+    // The second item: opaque (two-sided) or transmissive (one-sided).
+    for (text, two_sided) in cases {
         let m = parse(text);
         m.validate().unwrap_or_else(|e| panic!("{text}: {e}"));
-        assert_eq!(m.label(), label, "{text}");
+        assert_eq!(m.bsdf([0.5, 0.5]).is_two_sided(), two_sided, "{text}");
         assert_eq!(m.uses_uv(), text.contains("checkerboard"), "{text}");
         let wo = nalgebra::Vector3::new(0.3, 0.1, 0.9).normalize();
         let s = m.bsdf([0.3, 0.7]).sample(&wo, [0.4, 0.6, 0.2]);

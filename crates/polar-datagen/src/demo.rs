@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use polar_render::Polarization;
+use polar_sensor::SensorModel;
 use serde::Deserialize;
 
 use crate::Error;
@@ -15,16 +17,16 @@ use crate::scene::build_scene;
 use crate::store;
 use crate::suite::{FamilyKind, NoiseLevel, validate_noise};
 
-/// A Sony IMX250MZR-like sensor in 12-bit mode: full well ~10 500 e-, read noise ~2.3 e-,
-/// extinction ratio ~300 (Sony's datasheet figures at 525 nm).
+/// The noise of the Sony IMX250MZR preset ([`SensorModel::imx250mzr`]).
 pub fn realistic_noise() -> NoiseLevel {
+    let p = SensorModel::imx250mzr();
     NoiseLevel {
         name: "realistic".into(),
-        full_well_e: 10_500.0,
-        read_noise_e: 2.3,
-        bits: 12,
-        shot_noise: true,
-        extinction_ratio: Some(300.0),
+        full_well_e: p.full_well,
+        read_noise_e: p.read_noise,
+        bits: u8::try_from(p.bit_depth).expect("the preset's bit depth is at most 16"),
+        shot_noise: p.shot_noise,
+        extinction_ratio: Some(p.extinction_ratio),
     }
 }
 
@@ -162,11 +164,15 @@ fn parent_of(dir: &Path) -> PathBuf {
         .map_or_else(|| PathBuf::from("."), Path::to_owned)
 }
 
-/// Renders the demo into `out` (a sample directory with `pictures/`); returns the model name.
-pub fn run_demo(out: &Path, width: u32, height: u32, spp: u32) -> Result<String, Error> {
+/// Renders the demo into `out` (a sample directory with `pictures/`); returns the transport
+/// model used.
+pub fn run_demo(out: &Path, width: u32, height: u32, spp: u32) -> Result<Polarization, Error> {
     let params = demo_params(width, height, spp);
     let scene = build_scene(&params);
-    let record = serde_json::to_value(&params).unwrap_or_default();
+    let record = serde_json::to_value(&params).map_err(|e| Error::Sample {
+        id: params.id.clone(),
+        message: format!("parameters to JSON: {e}"),
+    })?;
     render_into(out, &scene, &params.noise, &record)
 }
 
@@ -240,7 +246,7 @@ pub fn render_into(
     scene: &polar_render::Scene,
     noise: &NoiseLevel,
     record: &serde_json::Value,
-) -> Result<String, Error> {
+) -> Result<Polarization, Error> {
     check_sample_target(out)?;
     let parent = parent_of(out);
     let name = sample_name(out)?;
@@ -253,7 +259,7 @@ pub fn render_into(
         write_sample(&staged, scene, &result, noise, record, &name)?;
         write_pictures(&staged.join("pictures"), &result.stokes)?;
         store::commit_dir(&parent, &staged, &name)?;
-        Ok(format!("{:?}", result.model))
+        Ok(result.model)
     });
     if made.is_err() {
         // Best effort: the error that matters is the one returned.

@@ -132,7 +132,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         Command::Demo { out, size, spp } => {
             let model = run_demo(&out, size, size, spp)?;
             println!(
-                "wrote {} ({model} transport); pictures in {}",
+                "wrote {} ({model:?} transport); pictures in {}",
                 out.display(),
                 out.join("pictures").display()
             );
@@ -148,7 +148,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             check_sample_target(&out)?;
             let record = serde_json::json!({ "file": scene.display().to_string(), "spp": s.settings.spp, "seed": s.settings.seed });
             let model = polar_datagen::demo::render_into(&out, &s, &noise, &record)?;
-            println!("wrote {} ({model} transport)", out.display());
+            println!("wrote {} ({model:?} transport)", out.display());
             Ok(())
         }
         Command::Suite {

@@ -2,7 +2,7 @@
 //! Both fit in the unit ball (bounding radius <= 1) so that a uniform scale sets their size.
 
 use polar_render::TriangleMesh;
-use polar_render::scene::Vec3;
+use polar_render::Vec3;
 use std::f64::consts::PI;
 
 /// A sphere with smooth radial bumps, r(n) = (1 + a g(n)) / (1 + a) with

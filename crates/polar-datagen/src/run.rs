@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
+use polar_render::Polarization;
 use rayon::prelude::*;
 
 pub use polar_io::Shard;
@@ -21,7 +22,7 @@ use crate::suite::{SizeName, Suite};
 #[derive(Clone, Debug, PartialEq)]
 pub struct WorkReport {
     /// Light-transport model the renderer chose (e.g. which bounces and BSDF lobes it needed).
-    pub model: String,
+    pub model: Polarization,
     /// Seconds spent rendering.
     pub render_seconds: f64,
 }
@@ -81,7 +82,7 @@ pub struct FamilySummary {
     /// Render seconds over all committed samples of the family.
     pub render_seconds: f64,
     /// Light-transport models used.
-    pub models: BTreeSet<String>,
+    pub models: BTreeSet<Polarization>,
 }
 
 /// The outcome of a suite run.
@@ -289,7 +290,7 @@ pub fn run_suite(
 
 fn add_entry(f: &mut FamilySummary, e: &ManifestEntry) {
     f.render_seconds += e.timings.render_seconds;
-    f.models.insert(e.model.clone());
+    f.models.insert(e.model);
 }
 
 fn summary_skeleton(suite: &Suite, jobs: &[SampleParams], kept: &[ManifestEntry]) -> RunSummary {
@@ -325,7 +326,11 @@ impl RunSummary {
             let model = if f.models.is_empty() {
                 "-".into()
             } else {
-                f.models.iter().cloned().collect::<Vec<_>>().join(", ")
+                f.models
+                    .iter()
+                    .map(|m| format!("{m:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
             };
             t.push_str(&format!(
                 "{:<16} {:<12} {:>8} {:>8} {:>6} {:>10.1}  {}\n",

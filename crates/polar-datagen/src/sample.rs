@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use polar_image::{Gray, Image, StokesImage};
-use polar_render::{RenderOptions, RenderOutput, Scene};
+use polar_render::{Polarization, RenderOptions, RenderOutput, Scene};
 use polar_sensor::SensorModel;
 use serde::Serialize;
 
@@ -27,19 +27,23 @@ impl SampleWorker for RenderWorker {
     fn produce(&self, params: &SampleParams, dir: &Path) -> Result<WorkReport, Error> {
         let scene = build_scene(params);
         let out = render(&scene, &params.id)?;
-        let record = serde_json::to_value(params).unwrap_or_default();
+        let record = serde_json::to_value(params).map_err(|e| Error::Sample {
+            id: params.id.clone(),
+            message: format!("parameters to JSON: {e}"),
+        })?;
         write_sample(dir, &scene, &out, &params.noise, &record, &params.id)?;
         Ok(WorkReport {
-            model: format!("{:?}", out.model),
+            model: out.model,
             render_seconds: out.seconds,
         })
     }
 }
 
-/// Renders a scene (with a medium also its dehazed ground truth, see
-/// [`RenderOutput::dehazed`]), mapping errors to the sample id.
+/// Renders a scene (with a medium also its clear and dehazed ground truth, see
+/// [`RenderOutput::clear`] and [`RenderOutput::dehazed`]), mapping errors to the sample id.
 pub fn render(scene: &Scene, id: &str) -> Result<RenderOutput, Error> {
     let opts = RenderOptions {
+        clear: true,
         dehazed: true,
         ..RenderOptions::default()
     };
@@ -49,20 +53,22 @@ pub fn render(scene: &Scene, id: &str) -> Result<RenderOutput, Error> {
     })
 }
 
-/// The sensor of a noise level with auto-exposure for `stokes`, seeded by `seed`.
+/// The sensor of a noise level with auto-exposure for `stokes`, seeded by `seed`: the
+/// quantum efficiency of [`SensorModel::imx250mzr`], the rest from the noise level.
 pub fn sensor_model(noise: &NoiseLevel, stokes: &StokesImage, seed: u64) -> SensorModel {
+    let quantum_efficiency = SensorModel::imx250mzr().quantum_efficiency;
     let max_dn = f64::from((1u32 << noise.bits) - 1);
     let s0 = stokes.channel(0);
     let level = polar_sensor::picture::quantile(&s0, EXPOSURE_QUANTILE).map_or(0.0, f64::from);
-    let photons_per_unit = if level > 0.0 {
+    let electrons_per_unit = if level > 0.0 {
         EXPOSURE_TARGET * noise.full_well_e / level
     } else {
         1.0
     };
     SensorModel {
-        photons_per_unit,
+        photons_per_unit: electrons_per_unit / quantum_efficiency,
         extinction_ratio: noise.extinction_ratio.unwrap_or(f64::INFINITY),
-        quantum_efficiency: 1.0,
+        quantum_efficiency,
         gain: noise.full_well_e / max_dn,
         read_noise: noise.read_noise_e,
         full_well: noise.full_well_e,
@@ -89,7 +95,7 @@ struct Meta<'a> {
 #[derive(Serialize)]
 struct RendererMeta {
     name: &'static str,
-    model: String,
+    model: Polarization,
     spp: u32,
     max_depth: u32,
     split_depth: u32,
@@ -100,6 +106,7 @@ struct RendererMeta {
 struct SensorMeta<'a> {
     noise: &'a NoiseLevel,
     photons_per_unit: f64,
+    quantum_efficiency: f64,
     gain_e_per_dn: f64,
     bit_depth: u32,
     black_level: u16,
@@ -205,7 +212,7 @@ fn meta<'a>(
         generator: format!("polar-datagen {}", env!("CARGO_PKG_VERSION")),
         renderer: RendererMeta {
             name: "polar-render",
-            model: format!("{:?}", out.model),
+            model: out.model,
             spp: out.spp,
             max_depth: s.settings.max_depth,
             split_depth: s.settings.split_depth,
@@ -214,6 +221,7 @@ fn meta<'a>(
         sensor: SensorMeta {
             noise,
             photons_per_unit: model.photons_per_unit,
+            quantum_efficiency: model.quantum_efficiency,
             gain_e_per_dn: model.gain,
             bit_depth: model.bit_depth,
             black_level: model.black_level,

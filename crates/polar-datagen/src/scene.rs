@@ -9,7 +9,7 @@ use polar_bsdf::{
 };
 use polar_optics::scatter::PhaseFunction;
 use polar_optics::sky::RayleighSky;
-use polar_render::scene::Vec3;
+use polar_render::Vec3;
 use polar_render::shapes::{cube, rectangle, superquadric, torus, transform};
 use polar_render::{Camera, Emission, Geometry, Light, Medium, Scene, Shape};
 

@@ -7,6 +7,7 @@ use std::fs;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
+use polar_render::Polarization;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -37,7 +38,7 @@ pub struct ManifestEntry {
     /// SHA-256 (hex) of every file, by path relative to the sample directory ('/' separated).
     pub files: BTreeMap<String, String>,
     /// Light-transport model the renderer used.
-    pub model: String,
+    pub model: Polarization,
     /// Wall-clock seconds: render and the whole sample.
     pub timings: Timings,
 }

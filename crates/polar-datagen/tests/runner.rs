@@ -32,7 +32,7 @@ impl SampleWorker for Fake {
         std::fs::write(dir.join("raw.png"), p.seed.to_le_bytes()).unwrap();
         std::fs::write(dir.join("gt/depth.exr"), p.index.to_le_bytes()).unwrap();
         Ok(WorkReport {
-            model: "Fake".into(),
+            model: polar_render::Polarization::None,
             render_seconds: 0.0,
         })
     }

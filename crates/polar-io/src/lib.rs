@@ -28,7 +28,7 @@ pub use png::{
     write_gray16_png, write_rgb8_png,
 };
 pub use sample::{
-    GroundTruth, Sample, TRANSPARENT_MASK_ON, files, material, parse_json, parse_meta,
+    GroundTruth, MaterialLabel, Sample, TRANSPARENT_MASK_ON, files, parse_json, parse_meta,
     read_ground_truth, read_json, read_optional_meta, read_sample, read_sample_with, write_json,
     write_sample,
 };

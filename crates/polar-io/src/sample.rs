@@ -28,7 +28,7 @@ pub mod files {
     pub const GT_NORMAL: &str = "gt/normal.exr";
     /// Float32 Y: distance along -z, 0 where no surface.
     pub const GT_DEPTH: &str = "gt/depth.exr";
-    /// 8-bit labels, see [`crate::material`].
+    /// 8-bit labels, see [`MaterialLabel`].
     pub const GT_MATERIAL: &str = "gt/material.png";
     /// 8-bit mask: 255 on transparent objects, else 0.
     pub const GT_TRANSPARENT: &str = "gt/transparent.png";
@@ -82,16 +82,41 @@ pub mod files {
     }
 }
 
-/// Labels of `gt/material.png`.
-pub mod material {
-    /// Background: floors, walls, sky (excluded from accuracy figures).
-    pub const BACKGROUND: u8 = 0;
+/// Labels of `gt/material.png` (and of the vision CLI's `material.png`): the pixel value is
+/// the discriminant.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[repr(u8)]
+pub enum MaterialLabel {
+    /// Background: floors, walls, sky (excluded from accuracy figures); also where no
+    /// surface is.
+    #[default]
+    Background = 0,
     /// Opaque dielectric.
-    pub const DIELECTRIC: u8 = 1;
+    Dielectric = 1,
     /// Metal.
-    pub const METAL: u8 = 2;
+    Metal = 2,
     /// Transparent object.
-    pub const TRANSPARENT: u8 = 3;
+    Transparent = 3,
+}
+
+impl MaterialLabel {
+    /// Every label, in the order of their values.
+    pub const ALL: [Self; 4] = [
+        Self::Background,
+        Self::Dielectric,
+        Self::Metal,
+        Self::Transparent,
+    ];
+
+    /// The pixel value of the label.
+    pub const fn value(self) -> u8 {
+        self as u8
+    }
+
+    /// The label of pixel value `v`, if it is one.
+    pub fn from_value(v: u8) -> Option<Self> {
+        Self::ALL.into_iter().find(|l| l.value() == v)
+    }
 }
 
 /// Value of `gt/transparent.png` on transparent objects (0 elsewhere).
@@ -345,7 +370,7 @@ fn check_values(dir: &Path, s: &Sample) -> Result<()> {
     }
     if let Some(m) = &gt.material {
         check_u8(&dir.join(files::GT_MATERIAL), m, "a label 0..=3", |v| {
-            v <= material::TRANSPARENT
+            MaterialLabel::from_value(v).is_some()
         })?;
     }
     if let Some(t) = &gt.transparent {

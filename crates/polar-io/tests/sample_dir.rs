@@ -4,8 +4,8 @@ use std::path::Path;
 
 use polar_image::{Gray, Image, StokesImage};
 use polar_io::{
-    BitDepth, Error, GrayPng, GroundTruth, STOKES_CHANNELS, Sample, Validation, files, material,
-    read_json, read_sample, read_sample_with, write_exr, write_gray8_png, write_gray16_png,
+    BitDepth, Error, GrayPng, GroundTruth, MaterialLabel, STOKES_CHANNELS, Sample, Validation,
+    files, read_json, read_sample, read_sample_with, write_exr, write_gray8_png, write_gray16_png,
     write_json, write_sample,
 };
 use serde_json::{Map, Value, json};
@@ -230,7 +230,8 @@ fn invalid_ground_truth_values_are_refused_on_write() {
     let mut inf_normal = full_sample();
     inf_normal.gt.normal.as_mut().unwrap().as_mut_slice()[1] = f32::INFINITY;
     let mut bad_label = full_sample();
-    bad_label.gt.material.as_mut().unwrap().as_mut_slice()[0] = material::TRANSPARENT + 1;
+    bad_label.gt.material.as_mut().unwrap().as_mut_slice()[0] =
+        MaterialLabel::Transparent.value() + 1;
     let mut bad_mask = full_sample();
     bad_mask.gt.transparent.as_mut().unwrap().as_mut_slice()[0] = 1;
     let mut neg_depth = full_sample();

@@ -16,17 +16,18 @@ pub mod fresnel_cues;
 pub mod rule;
 
 use polar_image::{Gray, Image};
+use polar_io::MaterialLabel;
 use polar_sensor::Observation;
 use thiserror::Error;
 
 /// Label of background pixels (floors, walls, sky), as in `gt/material.png`.
-pub const BACKGROUND: u8 = 0;
+pub const BACKGROUND: u8 = MaterialLabel::Background.value();
 /// Label of opaque dielectric pixels.
-pub const DIELECTRIC: u8 = 1;
+pub const DIELECTRIC: u8 = MaterialLabel::Dielectric.value();
 /// Label of metal pixels.
-pub const METAL: u8 = 2;
+pub const METAL: u8 = MaterialLabel::Metal.value();
 /// Label of transparent pixels (only where a transparency mask is given).
-pub const TRANSPARENT: u8 = 3;
+pub const TRANSPARENT: u8 = MaterialLabel::Transparent.value();
 
 /// Errors of material classification.
 #[derive(Debug, Error)]

@@ -52,6 +52,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         &scene,
         &RenderOptions {
             force_model: model,
+            clear: true,
             dehazed: true,
         },
         &|done, total| {

@@ -1,7 +1,8 @@
 //! Pinhole camera in the conventions' camera frame: x right, y up, z toward
 //! the viewer (the camera looks along -z), row 0 at the top.
 
-use crate::scene::{Camera, Vec3};
+use crate::math::Vec3;
+use crate::scene::Camera;
 
 /// A camera ready to generate rays.
 #[derive(Clone, Debug)]

@@ -6,7 +6,8 @@
 //! final hit) is done in `f64` in the scene's own primitive list, which is
 //! reordered once after the build to obvhs's primitive order.
 
-use crate::scene::{Geometry, Scene, Vec3};
+use crate::math::Vec3;
+use crate::scene::{Geometry, Scene};
 use glam::Vec3A;
 use obvhs::{
     Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::Ray,
@@ -298,7 +299,7 @@ impl Accel {
                 // Spherical coordinates cost an atan2 and an acos: only for textures.
                 let uses_uv = scene.shapes[shape]
                     .material
-                    .is_some_and(|m| scene.materials[m].1.uses_uv());
+                    .is_some_and(|m| scene.materials[m].material.uses_uv());
                 let uv = if uses_uv {
                     let u = (n.y.atan2(n.x) / std::f64::consts::TAU).rem_euclid(1.0);
                     [u, n.z.clamp(-1.0, 1.0).acos() / std::f64::consts::PI]

@@ -17,9 +17,10 @@
 //! `rotate_mueller_basis` (Mitsuba 3) with a quarter of the rotations. Emitted
 //! Stokes (implicit frame of its direction) is rotated only when polarized.
 
-use crate::geometry::SurfaceHit;
+use crate::geometry::{RAY_EPSILON, SurfaceHit};
+use crate::math::Vec3;
 use crate::sampler::Sampler;
-use crate::scene::Vec3;
+use crate::settings::{MAX_SPLIT_DEPTH, RR_DEPTH};
 use crate::tracking::Flight;
 use crate::transport::Transport;
 use crate::world::{LightSample, PickedLight, World};
@@ -68,14 +69,6 @@ fn into_frame(s: &Stokes, k: &Vec3, x: impl FnOnce() -> Vec3) -> Stokes {
     }
 }
 
-/// Russian roulette starts at this bounce (Mitsuba's default `rr_depth`): earlier,
-/// it mostly kills glass paths whose throughput is still near 1, adding variance.
-const RR_DEPTH: u32 = 5;
-
-/// The deepest `split_depth` (see [`crate::RenderSettings`]): split paths stay
-/// above Russian roulette, which divides their share out.
-pub const MAX_SPLIT_DEPTH: u32 = RR_DEPTH;
-
 /// The power heuristic with exponent 2.
 fn power_heuristic(a: f64, b: f64) -> f64 {
     let (a2, b2) = (a * a, b * b);
@@ -84,7 +77,7 @@ fn power_heuristic(a: f64, b: f64) -> f64 {
 
 /// Offset of a new ray origin off the surface, relative to the scene scale.
 fn spawn(hit: &SurfaceHit, d: &Vec3) -> Vec3 {
-    let eps = crate::geometry::RAY_EPSILON * (1.0 + hit.p.amax());
+    let eps = RAY_EPSILON * (1.0 + hit.p.amax());
     hit.p + hit.ng * eps.copysign(hit.ng.dot(d))
 }
 
@@ -178,9 +171,8 @@ impl Vertex<'_> {
     /// The normal about which light sampling draws environment directions
     /// cosine-weighted: at a surface whose sampling chooses between lobes (plastic,
     /// glass), where a light sample drawn from that sampling would draw the choice
-    /// again (measured: drawn from plastic's mixture, pplastic's polarization error
-    /// at 256 spp doubled, 0.027 % → 0.057 %: the noise the split at the camera
-    /// vertex removes). Elsewhere (`None`) the environment is sampled
+    /// again, bringing back the noise the split at the camera vertex removes.
+    /// Elsewhere (`None`) the environment is sampled
     /// with the vertex's own distribution ([`NextEvent::environment`]).
     fn cosine_environment(&self) -> Option<&Vec3> {
         match self {
@@ -345,11 +337,7 @@ impl<R: Transport, P: Fn(&Mueller) -> R> NextEvent<'_, '_, R, P> {
     /// the projected disk) that is the continuation's disk point mirrored through
     /// the centre, an antithetic pair: the polarization a microfacet tilted across
     /// the plane of incidence brings is odd in the tilt and cancels between the two
-    /// to first order. Rough conductor lit by the environment alone, 256 spp,
-    /// standard deviation per pixel (two seeds) relative to the mean S0, against
-    /// cosine-weighted light sampling: polarization 0.0159 % → 0.0112 %, S0
-    /// 0.233 % → 0.095 %; with both numbers shifted by ½ (no mirror) 0.0142 % /
-    /// 0.104 %.
+    /// to first order.
     #[inline(always)]
     fn environment(
         &self,
@@ -459,7 +447,7 @@ fn add<R: Transport>(sum: &mut Stokes, t: Option<&R>, le: &R::Stokes, w: f64) {
 
 /// A camera path between two vertices: the ray it follows and what it carries.
 #[derive(Clone, Copy)]
-struct Path<R> {
+struct PathState<R> {
     o: Vec3,
     d: Vec3,
     /// `None` while it is the identity (products with it are copies).
@@ -481,12 +469,12 @@ enum Step<R> {
     /// The path goes on.
     Continue,
     /// The path goes on, and so does this second one split off at its vertex.
-    Split(Path<R>),
+    Split(PathState<R>),
     /// The path has ended.
     End,
 }
 
-impl<R: Transport> Path<R> {
+impl<R: Transport> PathState<R> {
     fn camera(world: &World, d0: &Vec3) -> Self {
         Self {
             o: world.camera.position,
@@ -544,15 +532,17 @@ impl<R: Transport> Path<R> {
                     add(sum, self.throughput.as_ref(), &le, w);
                 }
                 let shape = &world.scene.shapes[hit.shape];
-                let Some(material) = shape.material.map(|m| &world.scene.materials[m].1) else {
+                let Some(material) = shape.material.map(|m| &world.scene.materials[m].material)
+                else {
                     return Step::End;
                 };
                 if depth == max_depth {
                     return Step::End;
                 }
-                let frame = Frame::new(shading_normal(&hit, &d, material.label()));
+                let bsdf = material.bsdf(hit.uv);
+                let frame = Frame::new(shading_normal(&hit, &d, bsdf.is_two_sided()));
                 Vertex::Surface {
-                    bsdf: material.bsdf(hit.uv),
+                    bsdf,
                     wo: frame.to_local(&-d),
                     frame,
                     hit,
@@ -691,27 +681,15 @@ impl<R: Transport> Path<R> {
 /// ray segments (no light sampling at delta vertices). The expectation over the
 /// choice instead of a draw: the front reflection carries most of glass's
 /// polarization, the paths inside a glass object polarize differently with each
-/// internal reflection, and plastic's two lobes polarize at right angles, so the
-/// draws were most of their polarization noise. Cross-check scenes at 256 spp:
-/// splitting the camera vertex (against the bench references, one thread, CPU
-/// time) took glass's polarization error 0.415 % → 0.207 %, S0 0.106 % → 0.072 %,
-/// for 1.35× the time, pplastic's 0.063 % → 0.027 % and 0.139 % → 0.087 %, for
-/// 1.45×; splitting glass down to depth 5 (standard deviation between two seeds
-/// over the sphere, 2 threads) polarization 0.213 % → 0.0127 %, S0 0.074 % →
-/// 0.016 %, for 2.9× the time (split_depth 1 to 5: 0.213, 0.121, 0.046, 0.024,
-/// 0.0127 %, for 1, 1.5, 2.0, 2.5, 2.9× the time). A split-off path is traced after
-/// the one it split from, with its own stream ([`Sampler::branch`]).
+/// internal reflection, and plastic's two lobes polarize at right angles, so a
+/// drawn choice is most of their polarization noise. A split-off path is traced
+/// after the one it split from, with its own stream ([`Sampler::branch`]).
 ///
 /// Work skipped without changing a bit of the result: the film frame is only
 /// computed when something polarized or a vertex needs it (a primary ray that
 /// sees an unpolarized environment never does), and the throughput is `None`
-/// while it is the identity (products with it are copies). The path state as a
-/// struct ([`Path`], so that a split copies it) costs 5.6 % more instructions per
-/// sample on the smooth conductor than locals did (callgrind, 16 spp). Measured
-/// alternatives, per sample against this one: locals, with the split-off path in
-/// a second inlined copy of the loop, 1.2 % fewer (not taken: it writes the path
-/// update twice); the state passed by value or the loop re-entered with locals,
-/// 5–8 % more.
+/// while it is the identity (products with it are copies). The path state is a
+/// struct ([`PathState`]) so that a split copies it.
 #[inline(always)]
 pub(crate) fn radiance<R: Transport>(
     world: &World,
@@ -721,7 +699,7 @@ pub(crate) fn radiance<R: Transport>(
 ) -> Stokes {
     debug_assert!(waiting.0.is_empty());
     let mut sum = Stokes::zeros();
-    let mut path = Path::<R>::camera(world, d0);
+    let mut path = PathState::<R>::camera(world, d0);
     let mut splits = 0;
     loop {
         match path.step(world, d0, sampler, &mut sum) {
@@ -740,9 +718,9 @@ pub(crate) fn radiance<R: Transport>(
 
 /// Paths split off and waiting to be traced, last in first out, each with its own
 /// stream. A path split off at depth d splits only deeper, so at most one per
-/// depth above `split_depth` waits. The caller keeps it across samples: as a
-/// fresh array per sample it cost 340 instructions per sample (callgrind).
-pub(crate) struct SplitPaths<R>(Vec<(Path<R>, Sampler)>);
+/// depth above `split_depth` waits. The caller keeps it across samples, so that
+/// no sample allocates.
+pub(crate) struct SplitPaths<R>(Vec<(PathState<R>, Sampler)>);
 
 impl<R> SplitPaths<R> {
     pub(crate) fn new() -> Self {
@@ -750,12 +728,11 @@ impl<R> SplitPaths<R> {
     }
 }
 
-/// The shading normal, flipped toward the viewer for opaque materials (labels 1
-/// and 2) so that they are two-sided; transmissive ones keep their orientation,
-/// which tells inside from outside.
-fn shading_normal(hit: &SurfaceHit, d: &Vec3, label: u8) -> Vec3 {
-    let opaque = matches!(label, 1 | 2);
-    if opaque && hit.ng.dot(d) > 0.0 {
+/// The shading normal, flipped toward the viewer for a two-sided BSDF
+/// ([`polar_bsdf::Bsdf::is_two_sided`]); a one-sided (transmissive) one keeps its
+/// orientation, which tells inside from outside.
+fn shading_normal(hit: &SurfaceHit, d: &Vec3, two_sided: bool) -> Vec3 {
+    if two_sided && hit.ng.dot(d) > 0.0 {
         -hit.ns
     } else {
         hit.ns

@@ -13,23 +13,27 @@
 mod camera;
 mod geometry;
 mod integrator;
+pub mod math;
 pub mod medium;
 mod render;
 pub mod sampler;
 pub mod scene;
 pub mod scene_file;
+pub mod settings;
 pub mod shapes;
 mod tracking;
 pub mod transport;
 mod world;
 
-pub use integrator::MAX_SPLIT_DEPTH;
+pub use math::Vec3;
 pub use medium::{DensityGrid, Medium};
 pub use polar_bsdf::{Material, Polarization};
 pub use render::{RenderOptions, RenderOutput, render, required_model};
 pub use sampler::SamplerKind;
-pub use scene::{Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, TriangleMesh};
+pub use scene::{Camera, Emission, Geometry, Light, NamedMaterial, Scene, Shape};
 pub use scene_file::{load_scene, parse_scene};
+pub use settings::{MAX_SPLIT_DEPTH, RenderSettings};
+pub use shapes::TriangleMesh;
 
 use std::path::PathBuf;
 

@@ -4,7 +4,7 @@
 //! coefficients. The medium fills the whole box, including the inside of the
 //! shapes in it (a limit: a glass object in fog holds fog too).
 
-use crate::scene::Vec3;
+use crate::math::Vec3;
 use polar_bsdf::Polarization;
 use polar_optics::OpticsError;
 use polar_optics::scatter::PhaseFunction;

@@ -4,11 +4,12 @@
 use crate::Error;
 use crate::integrator::{SplitPaths, radiance};
 use crate::sampler::PixelStreams;
-use crate::scene::Scene;
+use crate::scene::{Light, Scene};
 use crate::transport::{Full, Linear, Scalar, Transport, emission_polarization};
 use crate::world::World;
-use polar_bsdf::Polarization;
+use polar_bsdf::{Material, Polarization};
 use polar_image::{Gray, Image, StokesImage};
+use polar_io::{MaterialLabel, TRANSPARENT_MASK_ON};
 use polar_optics::Stokes;
 use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
@@ -24,6 +25,9 @@ pub struct RenderOptions {
     /// Transport model to use instead of the cheapest exact one; must not be
     /// cheaper than the scene needs (that would be inexact).
     pub force_model: Option<Polarization>,
+    /// With a medium, also render [`RenderOutput::clear`] (one more render of the
+    /// view); ignored without a medium.
+    pub clear: bool,
     /// With a medium, also render [`RenderOutput::dehazed`] (one more render of the
     /// view); ignored without a medium.
     pub dehazed: bool,
@@ -38,12 +42,13 @@ pub struct RenderOutput {
     pub normal: Image<f32, 3>,
     /// Distance along the viewing axis (camera -z) to the first hit; 0 where no surface.
     pub depth: Gray<f32>,
-    /// Material labels: 0 background, 1 opaque dielectric, 2 metal, 3 transparent.
+    /// Material labels ([`MaterialLabel`] values).
     pub material: Gray<u8>,
-    /// 255 on transparent objects, else 0.
+    /// [`TRANSPARENT_MASK_ON`] on transparent objects, else 0.
     pub transparent: Gray<u8>,
     /// S0 of the same view rendered without the participating medium (same
-    /// seed and samples); `None` when the scene has no medium.
+    /// seed and samples); `None` unless asked for ([`RenderOptions::clear`]) and the
+    /// scene has a medium.
     pub clear: Option<Gray<f32>>,
     /// S0 of the same view (same seed) with the medium removed from the camera
     /// segment of every path only: from the camera to the first surface (or on to
@@ -73,17 +78,17 @@ pub fn required_model(scene: &Scene) -> Polarization {
         .shapes
         .iter()
         .filter_map(|s| s.material)
-        .map(|m| scene.materials[m].1.bsdf([0.5, 0.5]).polarization());
+        .map(|m| scene.materials[m].material.bsdf([0.5, 0.5]).polarization());
     let emitters = scene
         .shapes
         .iter()
         .filter_map(|s| s.emission)
         .map(|e| emission_polarization(&e.polarization));
     let lights = scene.lights.iter().map(|l| match l {
-        crate::Light::Environment(e) | crate::Light::Sun { emission: e, .. } => {
+        Light::Environment(e) | Light::Sun { emission: e, .. } => {
             emission_polarization(&e.polarization)
         }
-        crate::Light::Sky(_) => Polarization::Linear,
+        Light::Sky(_) => Polarization::Linear,
     });
     let medium = scene.medium.iter().map(|m| m.polarization());
     materials
@@ -107,15 +112,15 @@ struct TileResult {
 struct GroundTruth {
     normal: [f32; 3],
     depth: f32,
-    label: u8,
+    label: MaterialLabel,
     /// Transmittance of the medium along the central ray (1 without a medium).
     transmission: f32,
 }
 
 /// Renders `scene` with the cheapest exact transport (or `opts.force_model`),
 /// using the current rayon thread pool. `progress(done, total)` is called after each tile
-/// (with a medium, a second round follows for the medium-free `clear` render, and a
-/// third for `dehazed` when asked for).
+/// (with a medium, one more round follows for each of the `clear` and `dehazed` renders
+/// asked for).
 /// The result is bit-identical for the same scene and seed whatever the thread count.
 pub fn render(
     scene: &Scene,
@@ -136,24 +141,30 @@ pub fn render(
     let seconds = start.elapsed().as_secs_f64();
     let mut out = assemble(scene, tiles, model, seconds);
     if scene.medium.is_some() {
-        let clear_scene = Scene {
-            medium: None,
-            ..scene.clone()
-        };
-        let clear_model = opts.force_model.unwrap_or(required_model(&clear_scene));
-        let clear = assemble(
-            &clear_scene,
-            render_with(&clear_scene, clear_model, false, progress),
-            clear_model,
-            0.0,
-        );
-        out.clear = Some(clear.stokes.channel(0));
+        if opts.clear {
+            out.clear = Some(render_clear(scene, opts, progress));
+        }
         if opts.dehazed {
             let dehazed = assemble(scene, render_with(scene, model, true, progress), model, 0.0);
             out.dehazed = Some(dehazed.stokes.channel(0));
         }
     }
     Ok(out)
+}
+
+/// S0 of `scene` rendered without its medium ([`RenderOutput::clear`]).
+fn render_clear(
+    scene: &Scene,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Gray<f32> {
+    let clear_scene = Scene {
+        medium: None,
+        ..scene.clone()
+    };
+    let model = opts.force_model.unwrap_or(required_model(&clear_scene));
+    let tiles = render_with(&clear_scene, model, false, progress);
+    assemble(&clear_scene, tiles, model, 0.0).stokes.channel(0)
 }
 
 /// Renders the tiles of a validated scene with transport `model`, on the best
@@ -219,11 +230,7 @@ fn render_tiles<R: Transport>(
 /// has. Only code inlined into the loop gets the target's instructions, hence
 /// `#[inline(always)]` down the per-sample path (integrator, sampler, intersection,
 /// BSDFs, Fresnel). Images are the same bit for bit on every target (Rust never
-/// contracts `a * b + c` into an FMA; a test compares the targets). Measured on the
-/// cross-check scenes (1 thread, 256 spp, CPU time, median of 5 alternating runs, AMD
-/// EPYC with AVX-512): the AVX-512 loop takes 6–11 % less than the same loop on the
-/// baseline on conductor, rough conductor and plastic (glass 2 % more, haze equal),
-/// the AVX2 one 1–7 % less; the inlining itself saves 13–32 % on the baseline.
+/// contracts `a * b + c` into an FMA; a test compares the targets).
 struct TileOp<'a, R> {
     world: &'a World<'a>,
     origin: (usize, usize),
@@ -271,8 +278,7 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
 ///
 /// Each camera ray is set up before the previous path is traced: its Sobol draw,
 /// divisions and square root then overlap that path instead of delaying the next
-/// one (measured, 1 thread, 3-4 rounds of alternating runs: about 5 % less CPU
-/// time on conductor, glass and rough conductor; pplastic and haze within noise).
+/// one.
 /// Inlined into the SIMD dispatch of [`TileOp`].
 #[inline(always)]
 fn pixel_sum<R: Transport>(world: &World, x: usize, y: usize) -> Stokes {
@@ -319,14 +325,25 @@ fn ground_truth(world: &World, x: usize, y: usize) -> GroundTruth {
     };
     let n = world.camera.to_camera(&n);
     let label = match (shape.background, shape.material) {
-        (false, Some(m)) => world.scene.materials[m].1.label(),
-        _ => 0,
+        (false, Some(m)) => material_label(&world.scene.materials[m].material),
+        _ => MaterialLabel::Background,
     };
     GroundTruth {
         normal: [n.x as f32, n.y as f32, n.z as f32],
         depth: world.camera.depth(&hit.p) as f32,
         label,
         transmission,
+    }
+}
+
+/// The ground-truth label of an object's material (docs/conventions.md).
+fn material_label(m: &Material) -> MaterialLabel {
+    match m {
+        Material::Lambertian(_) | Material::Plastic(_) => MaterialLabel::Dielectric,
+        Material::Conductor(_) => MaterialLabel::Metal,
+        Material::Dielectric(_) | Material::Polarizer(_) | Material::Retarder(_) => {
+            MaterialLabel::Transparent
+        }
     }
 }
 
@@ -349,8 +366,12 @@ fn assemble(
             stokes.pixels_mut()[p] = *s;
             normal.pixels_mut()[p] = g.normal;
             depth.pixels_mut()[p] = [g.depth];
-            material.pixels_mut()[p] = [g.label];
-            transparent.pixels_mut()[p] = [if g.label == 3 { 255 } else { 0 }];
+            material.pixels_mut()[p] = [g.label.value()];
+            transparent.pixels_mut()[p] = [if g.label == MaterialLabel::Transparent {
+                TRANSPARENT_MASK_ON
+            } else {
+                0
+            }];
             transmission.pixels_mut()[p] = [g.transmission];
         }
     }
@@ -372,7 +393,8 @@ fn assemble(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{SamplerKind, load_scene};
+    use crate::sampler::SamplerKind;
+    use crate::scene_file::load_scene;
     use std::path::Path;
 
     /// The bits of the Stokes image of `scene` rendered on the SIMD target `arch`.

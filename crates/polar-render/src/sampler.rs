@@ -10,38 +10,12 @@
 //! data-dependent counts (delta and ratio tracking) and always come from an
 //! independent hash stream, so they never shift the aligned draws.
 //!
-//! Measured (S0 relative RMSE over the sphere pixels of the 128×128 cross-check scenes
-//! against two 8192-spp renders, their noise subtracted), independent → Sobol:
-//!
-//! | scene | 16 spp | 64 spp | 256 spp | 1024 spp |
-//! |---|---|---|---|---|
-//! | conductor | 0.094 → 0.015 % | 0.047 → 0.0030 % | 0.023 → 0.0008 % | 0.012 → 0.0002 % |
-//! | rough conductor | 5.7 → 1.7 % | 2.9 → 0.45 % | 1.4 → 0.14 % | 0.70 → 0.054 % |
-//! | pplastic | 3.0 → 1.4 % | 1.5 → 0.47 % | 0.74 → 0.17 % | 0.38 → 0.068 % |
-//! | glass | 1.8 → 1.9 % | 0.98 → 0.89 % | 0.48 → 0.49 % | 0.24 → 0.24 % |
-//!
-//! Glass gains little (4 seeds: 1.08× at 64 spp, 1.13× at 256): its error comes from
-//! chains of reflect/refract choices, each in its own padded draw. (This table is for
-//! padded draws throughout.) The *path point* ([`Sampler::next_scatter`]) draws the
-//! first bounce, the first flight step in a medium and the choices of delta vertices
-//! jointly with the jitter. Relative RMSE at 256 / 1024 spp, padded → path point (the
-//! benchmark's references, tools/mitsuba/bench.py, one render each, 2 threads):
-//!
-//! | scene | S0 | polarization (S1, S2) |
-//! |---|---|---|
-//! | conductor | unchanged (nothing drawn at its vertex) | unchanged |
-//! | rough conductor | 0.147 / 0.055 → 0.124 / 0.034 % | 0.0096 / 0.0038 → 0.0081 / 0.0022 % |
-//! | pplastic | 0.175 / 0.070 → 0.139 / 0.052 % | 0.073 / 0.028 → 0.063 / 0.023 % |
-//! | glass | 0.109 / 0.054 → 0.106 / 0.057 % | 0.66 / 0.34 → 0.42 / 0.145 % |
-//! | haze | 7.3 / 3.6 → 3.1 / 1.5 % | 5.7 / 2.8 → 3.0 / 1.4 % | The cost: a Sobol
-//! draw takes about 340 instructions against about 30 for three hash numbers
-//! (`sobol_burley::sample_4d` emulates its 32-bit multiplies without SSE4.1, still
-//! fewer instructions than two scalar `sample` calls); per path sample that is +420
-//! (conductor) to +550 instructions (callgrind, 16 spp − 1 spp), +17 % (pplastic) to
-//! +37 % (conductor), and 1.2× (pplastic), 1.3× (rough conductor), 1.35× (glass),
-//! 1.45× (conductor) the CPU time at equal spp (one thread, runs alternating). These
-//! costs were measured on the 2003 x86-64 baseline; the workspace now builds for
-//! x86-64-v2 (`.cargo/config.toml`), whose SSE4.1 multiplies make renders 4–13 % faster.
+//! With [`SamplerKind::Sobol`], the *path point* ([`Sampler::next_scatter`]) draws
+//! the first bounce, the first flight step in a medium and the choices of delta
+//! vertices jointly with the camera jitter; other draws are padded (each its own
+//! Owen-scrambled point). A Sobol draw costs more than hash numbers; its error
+//! against independent numbers at equal samples per pixel, scene by scene, is in
+//! docs/performance-notes.md.
 
 use serde::Deserialize;
 
@@ -214,7 +188,6 @@ impl Sampler {
     /// outcomes of a choice (the camera vertex of glass and plastic, smooth glass
     /// above `split_depth`), `u[0]` is drawn and not used, so with the default
     /// split depth the path point chooses only at glass vertices from depth 5 on.
-    /// Measured: see the module documentation.
     #[inline(always)]
     pub fn next_scatter(&mut self, depth: u32, choice: bool, point: bool) -> [f64; 3] {
         if self.kind == SamplerKind::Independent || (depth > 0 && point) {

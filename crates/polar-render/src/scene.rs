@@ -6,17 +6,15 @@
 //! `S0` in the implicit frame `x = polar_optics::stokes_basis(k)` of the
 //! propagation direction `k` (as Mitsuba 3 does for its polarized emitters).
 
-use crate::integrator::MAX_SPLIT_DEPTH;
+use crate::Error;
+use crate::math::Vec3;
 use crate::medium::Medium;
-use crate::sampler::SamplerKind;
-use crate::{Error, Material};
-use nalgebra::{Matrix4, Vector3};
+use crate::settings::{MAX_SPLIT_DEPTH, RenderSettings};
+use crate::shapes::{TriangleMesh, check_mesh};
+use polar_bsdf::Material;
 use polar_optics::OpticsError;
 use polar_optics::sky::RayleighSky;
 use std::path::Path;
-
-/// A 3-vector in world space.
-pub type Vec3 = Vector3<f64>;
 
 /// Largest image side in pixels a scene may ask for (the area is further bounded by
 /// [`polar_io::MAX_PIXELS`]), so a mistyped size is refused instead of exhausting memory.
@@ -44,35 +42,6 @@ pub struct Camera {
     pub width: usize,
     /// Image height in pixels.
     pub height: usize,
-}
-
-/// Sampling settings.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSettings {
-    /// Samples per pixel.
-    pub spp: u32,
-    /// Seed of the per-pixel sample streams.
-    pub seed: u64,
-    /// Maximum number of scattering events on a path (1 = direct lighting only).
-    pub max_depth: u32,
-    /// Vertices before this depth trace both outcomes of a lobe choice instead of
-    /// drawing one: the camera vertex of glass and plastic, and every smooth-glass
-    /// vertex (0 = never; at most [`MAX_SPLIT_DEPTH`], where Russian roulette starts).
-    pub split_depth: u32,
-    /// Where the sample points come from (Owen-scrambled Sobol by default).
-    pub sampler: SamplerKind,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            spp: 64,
-            seed: 0,
-            max_depth: 8,
-            split_depth: MAX_SPLIT_DEPTH,
-            sampler: SamplerKind::Sobol,
-        }
-    }
 }
 
 /// Emitted radiance with an optional polarization state.
@@ -134,36 +103,6 @@ pub(crate) fn sky_key(e: &OpticsError) -> &'static str {
     }
 }
 
-/// An indexed triangle mesh in world space.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct TriangleMesh {
-    /// Vertex positions.
-    pub positions: Vec<Vec3>,
-    /// Per-vertex shading normals (empty: flat shading from the winding order).
-    pub normals: Vec<Vec3>,
-    /// Per-vertex texture coordinates (empty: barycentric coordinates are used).
-    pub uvs: Vec<[f64; 2]>,
-    /// Counter-clockwise triangles (seen from the front), indices into the vertices.
-    pub triangles: Vec<[u32; 3]>,
-}
-
-impl TriangleMesh {
-    /// Applies an affine transform (normals by the inverse transpose).
-    pub fn transformed(mut self, m: &Matrix4<f64>) -> Self {
-        let lin = m.fixed_view::<3, 3>(0, 0).into_owned();
-        let normal_m = lin.try_inverse().map(|i| i.transpose()).unwrap_or(lin);
-        let t = m.fixed_view::<3, 1>(0, 3).into_owned();
-        self.positions.iter_mut().for_each(|p| *p = lin * *p + t);
-        self.normals
-            .iter_mut()
-            .for_each(|n| *n = (normal_m * *n).normalize());
-        if lin.determinant() < 0.0 {
-            self.triangles.iter_mut().for_each(|t| t.swap(1, 2));
-        }
-        self
-    }
-}
-
 /// The geometry of a shape.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
@@ -204,6 +143,15 @@ impl Shape {
     }
 }
 
+/// A material with the name the scene gives it (for error messages).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedMaterial {
+    /// The name, e.g. the key under `[materials]` in a scene file.
+    pub name: String,
+    /// The material.
+    pub material: Material,
+}
+
 /// A complete scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -212,7 +160,7 @@ pub struct Scene {
     /// Sampling settings.
     pub settings: RenderSettings,
     /// Named materials; shapes refer to them by index.
-    pub materials: Vec<(String, Material)>,
+    pub materials: Vec<NamedMaterial>,
     /// Shapes.
     pub shapes: Vec<Shape>,
     /// Environment and sun lights.
@@ -239,7 +187,10 @@ impl Scene {
 
     /// Adds a named material and returns its index for [`Shape::material`].
     pub fn add_material(&mut self, name: &str, material: Material) -> usize {
-        self.materials.push((name.to_owned(), material));
+        self.materials.push(NamedMaterial {
+            name: name.to_owned(),
+            material,
+        });
         self.materials.len() - 1
     }
 }
@@ -303,8 +254,9 @@ impl Scene {
                 format!("must be at most {MAX_SPLIT_DEPTH} (where Russian roulette starts)"),
             );
         }
-        for (name, m) in &self.materials {
-            if let Err(polar_bsdf::Error::InvalidParameter { field, reason }) = m.validate() {
+        for NamedMaterial { name, material } in &self.materials {
+            if let Err(polar_bsdf::Error::InvalidParameter { field, reason }) = material.validate()
+            {
                 return bad(format!("materials.{name}.{field}"), reason);
             }
         }
@@ -383,7 +335,7 @@ impl Scene {
                     ));
                 }
             }
-            Geometry::Mesh(m) => crate::shapes::check_mesh(m).map_err(|r| ("geometry", r))?,
+            Geometry::Mesh(m) => check_mesh(m).map_err(|r| ("geometry", r))?,
         }
         if let Some(e) = &s.emission {
             check_emission(e).map_err(|(k, r)| {

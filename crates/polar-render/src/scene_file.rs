@@ -3,11 +3,11 @@
 //! errors) and every error names the file, the key and the reason.
 
 use crate::Error;
+use crate::math::Vec3;
 use crate::medium::{DensityGrid, Medium, check_resolution, phase_key};
 use crate::sampler::SamplerKind;
-use crate::scene::{
-    Camera, Emission, Geometry, Light, RenderSettings, Scene, Shape, Vec3, sky_key,
-};
+use crate::scene::{Camera, Emission, Geometry, Light, Scene, Shape, sky_key};
+use crate::settings::RenderSettings;
 use crate::shapes;
 use num_complex::Complex64;
 use polar_optics::scatter::PhaseFunction;

@@ -2,10 +2,40 @@
 //! Mitsuba) and triangle-mesh loading from PLY and OBJ files.
 
 use crate::Error;
-use crate::scene::{TriangleMesh, Vec3};
+use crate::math::Vec3;
 use nalgebra::{Matrix4, Rotation3};
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
+
+/// An indexed triangle mesh in world space.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (empty: flat shading from the winding order).
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates (empty: barycentric coordinates are used).
+    pub uvs: Vec<[f64; 2]>,
+    /// Counter-clockwise triangles (seen from the front), indices into the vertices.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    /// Applies an affine transform (normals by the inverse transpose).
+    pub fn transformed(mut self, m: &Matrix4<f64>) -> Self {
+        let lin = m.fixed_view::<3, 3>(0, 0).into_owned();
+        let normal_m = lin.try_inverse().map(|i| i.transpose()).unwrap_or(lin);
+        let t = m.fixed_view::<3, 1>(0, 3).into_owned();
+        self.positions.iter_mut().for_each(|p| *p = lin * *p + t);
+        self.normals
+            .iter_mut()
+            .for_each(|n| *n = (normal_m * *n).normalize());
+        if lin.determinant() < 0.0 {
+            self.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+        }
+        self
+    }
+}
 
 /// An affine transform `translate · rotate · scale` (rotation as Euler angles
 /// in degrees applied about x, then y, then z).

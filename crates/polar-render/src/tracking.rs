@@ -4,9 +4,9 @@
 //! (Novák et al. 2014, "Residual ratio tracking for estimating attenuation in
 //! participating media"), and the exact optical depth for the ground truth.
 
+use crate::math::Vec3;
 use crate::medium::Medium;
 use crate::sampler::Sampler;
-use crate::scene::Vec3;
 
 /// What happens to a ray segment in the medium.
 #[derive(Clone, Copy, Debug)]

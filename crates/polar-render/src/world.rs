@@ -3,8 +3,9 @@
 
 use crate::camera::PinholeCamera;
 use crate::geometry::{Accel, SurfaceHit};
+use crate::math::Vec3;
 use crate::sampler::Sampler;
-use crate::scene::{Emission, Light, Scene, Vec3};
+use crate::scene::{Emission, Light, Scene};
 use crate::tracking::{self, Flight};
 use polar_optics::Stokes;
 use polar_optics::sky::RayleighSky;

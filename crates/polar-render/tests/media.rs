@@ -359,6 +359,10 @@ fn hazy_render_is_bit_identical_across_thread_counts_and_has_ground_truth() {
     let one = run_on_threads(&s, 1);
     assert!(one.clear.is_some());
     assert_eq!(bits(&one), bits(&run_on_threads(&s, 2)));
+    // The clear view is an option: without it, the same image and no clear render.
+    let lean = render(&s, &RenderOptions::default(), &|_, _| {}).expect("render");
+    assert!(lean.clear.is_none() && lean.transmission.is_some());
+    assert_eq!(bits(&lean), bits(&one)[..bits(&lean).len()]);
     // The clear image is the medium-free render of the same view.
     let mut no_medium = s.clone();
     no_medium.medium = None;

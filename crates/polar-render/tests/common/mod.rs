@@ -18,18 +18,21 @@ pub fn camera(distance: f64, fov_deg: f64, size: usize) -> Camera {
     }
 }
 
-/// Renders silently, with the cheapest exact model or the one forced.
+/// Renders silently, with the cheapest exact model or the one forced (with a medium,
+/// also the clear view).
 pub fn run(scene: &Scene, model: Option<Polarization>) -> RenderOutput {
     let opts = RenderOptions {
         force_model: model,
+        clear: true,
         ..Default::default()
     };
     render(scene, &opts, &|_, _| {}).expect("render")
 }
 
-/// Renders silently with the cheapest exact model, with the dehazed ground truth.
+/// Renders silently with the cheapest exact model, with the clear and dehazed ground truth.
 pub fn run_dehazed(scene: &Scene) -> RenderOutput {
     let opts = RenderOptions {
+        clear: true,
         dehazed: true,
         ..Default::default()
     };

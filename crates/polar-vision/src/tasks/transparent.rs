@@ -4,8 +4,8 @@
 
 use polar_eval::mask_metrics;
 use polar_image::Gray;
-use polar_io::Y_CHANNEL;
 use polar_io::files::vision;
+use polar_io::{MaterialLabel, Y_CHANNEL};
 use polar_transparency::{TransparencyOptions, detect};
 
 use super::{Context, Failure, Outcome, io, picture_path, to_json};
@@ -36,7 +36,11 @@ pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> 
 fn opaque_objects(labels: &Gray<u8>) -> Gray<u8> {
     let mut m = labels.clone();
     for v in m.as_mut_slice() {
-        *v = u8::from(*v == polar_io::material::DIELECTRIC || *v == polar_io::material::METAL);
+        let label = MaterialLabel::from_value(*v);
+        *v = u8::from(matches!(
+            label,
+            Some(MaterialLabel::Dielectric | MaterialLabel::Metal)
+        ));
     }
     m
 }
