@@ -47,6 +47,67 @@ fn eval(families: &str, tasks: &str, jobs: &str) -> (tempfile::TempDir, serde_js
     (out, metrics)
 }
 
+/// `train material` on the ci material family writes a model that `eval --material-model`
+/// uses: every sample is classified (the accuracy of a model trained on 4 tiny samples is
+/// not asserted), and a model file of another kind is refused before any sample runs.
+#[test]
+fn train_material_then_eval_with_the_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("material.knn");
+    let ok = vision(&[
+        "train",
+        "material",
+        arg(standard_ci()),
+        "--family",
+        "materials",
+        "--out",
+        arg(&model),
+        "--max-points",
+        "500",
+    ])
+    .expect("train completes");
+    assert!(ok && model.is_file());
+    let out = dir.path().join("eval");
+    let ok = vision(&[
+        "eval",
+        arg(standard_ci()),
+        "--family",
+        "materials",
+        "--tasks",
+        "material",
+        "--material-model",
+        arg(&model),
+        "--out",
+        arg(&out),
+    ])
+    .expect("eval completes");
+    assert!(ok, "see {}", out.display());
+    let acc = family_mean(
+        &json(&out.join("metrics.json")),
+        "materials",
+        "material",
+        "metal_vs_dielectric_accuracy",
+    );
+    assert!((0.0..=1.0).contains(&acc), "{acc}");
+    let bad = dir.path().join("bad.knn");
+    std::fs::write(&bad, b"not a model").unwrap();
+    let err = vision(&[
+        "run",
+        arg(&standard_ci().join("materials-00000")),
+        "--tasks",
+        "material",
+        "--material-model",
+        arg(&bad),
+        "--out",
+        arg(&dir.path().join("run")),
+    ])
+    .unwrap_err();
+    assert!(
+        err.contains("--material-model") && err.contains("bad.knn"),
+        "{err}"
+    );
+}
+
 #[test]
 fn shape_from_polarization_on_the_ci_shape_family() {
     let (_dir, m) = eval("sfp", "sfp", "2");

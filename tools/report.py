@@ -43,7 +43,8 @@ TASKS = {
     }),
     "material": (["materials", "mts-material"], "metal_vs_dielectric_accuracy", "metal vs dielectric accuracy",
                  False, {"physics rule, with sfp normals": ["--tasks", "sfp,material"],
-                         "physics rule, no normals": ["--tasks", "material"]}),
+                         "physics rule, no normals": ["--tasks", "material"],
+                         "kNN, builtin model": ["--tasks", "material", "--material-model", "builtin"]}),
     "transparent": (["glass"], "iou", "mask IoU", False, {"training-free": []}),
     "dehaze": (["haze"], "against_dehazed.dehazed.psnr_db", "PSNR vs gt/dehazed (dB)", False, {
         "polarization": ["--dehaze-method", "polarization"],

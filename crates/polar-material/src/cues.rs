@@ -22,6 +22,9 @@ use nalgebra::Vector3;
 pub struct Cues {
     /// `cos 2(AoLP − azimuth)` in `[-1, 1]`; NaN where the azimuth is unknown.
     pub phase: Vec<f32>,
+    /// `sin 2(AoLP − azimuth)`, NaN where the azimuth is unknown: with `phase`, the full
+    /// angle (its sign tells a rotation of the AoLP away from the azimuth's axes).
+    pub phase_sin: Vec<f32>,
     /// Zenith angle of the normal from the view direction (radians); NaN where unknown.
     pub zenith: Vec<f32>,
     /// `true` when `zenith` is the silhouette's sphere prior rather than measured.
@@ -44,6 +47,7 @@ pub fn from_normals(
     }
     let n = w * h;
     let mut phase = vec![f32::NAN; n];
+    let mut phase_sin = vec![f32::NAN; n];
     let mut zenith = vec![f32::NAN; n];
     for y in 0..h {
         for x in 0..w {
@@ -56,11 +60,12 @@ pub fn from_normals(
             }
             let (az, ze) = obs.pixel_frame(x, y).angles(&(v / len));
             zenith[k] = ze as f32;
-            phase[k] = (2.0 * (f.aolp[k] - az as f32)).cos();
+            (phase_sin[k], phase[k]) = (2.0 * (f.aolp[k] - az as f32)).sin_cos();
         }
     }
     Ok(Cues {
         phase,
+        phase_sin,
         zenith,
         prior: false,
     })
@@ -83,6 +88,7 @@ pub fn from_silhouette(f: &Features, fg: &[bool]) -> Result<Cues, MaterialError>
     gaussian_blur(&m, &mut blur, ks, BAND as f64 * 0.6)?;
     let b = blur.as_slice();
     let mut phase = vec![f32::NAN; n];
+    let mut phase_sin = vec![f32::NAN; n];
     for y in 1..h.saturating_sub(1) {
         for x in 1..w.saturating_sub(1) {
             let k = y * w + x;
@@ -97,12 +103,13 @@ pub fn from_silhouette(f: &Features, fg: &[bool]) -> Result<Cues, MaterialError>
             }
             // Outward = −∇; image y runs down, the Stokes frame's y_ref up.
             let beta = gy.atan2(-gx);
-            phase[k] = (2.0 * (f.aolp[k] - beta)).cos();
+            (phase_sin[k], phase[k]) = (2.0 * (f.aolp[k] - beta)).sin_cos();
         }
     }
     let zenith = sphere_prior_zenith(fg, w, h)?;
     Ok(Cues {
         phase,
+        phase_sin,
         zenith,
         prior: true,
     })

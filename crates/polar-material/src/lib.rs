@@ -13,7 +13,10 @@ pub mod cues;
 pub mod features;
 pub mod foreground;
 pub mod fresnel_cues;
+pub mod knn;
 pub mod rule;
+
+use std::sync::Arc;
 
 use polar_image::{Gray, Image};
 use polar_io::MaterialLabel;
@@ -50,11 +53,25 @@ pub enum MaterialError {
     Imgproc(#[from] polar_imgproc::Error),
 }
 
+/// What every classifier starts from: the features, the object pixels and the cues.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// Per-pixel polarization features.
+    pub features: features::Features,
+    /// `true` on object pixels (opaque: transparent pixels are cleared).
+    pub fg: Vec<bool>,
+    /// Phase and zenith cues, from the normals where given, else from the silhouettes.
+    pub cues: cues::Cues,
+}
+
 /// Which classifier decides dielectric versus metal.
 #[derive(Clone, Debug)]
 pub enum Classifier {
     /// The training-free Fresnel / AoLP-phase rule of [`rule`].
     Physics,
+    /// k nearest neighbours over [`knn::FEATURES`] from a trained model file; it uses the
+    /// silhouette cues it was trained with, never the given normals.
+    Knn(Arc<knn::KnnClassifier>),
 }
 
 /// Options of [`classify`].
@@ -86,7 +103,8 @@ pub struct MaterialMap {
 ///
 /// `normals`: camera-frame unit normals (e.g. from shape from polarization; `(0,0,0)` =
 /// unknown) give the zenith and azimuth at every pixel; without them the azimuth is taken
-/// from the object silhouettes. `foreground`: non-zero on object pixels; without it
+/// from the object silhouettes (the kNN always takes them from the silhouettes, as it was
+/// trained). `foreground`: non-zero on object pixels; without it
 /// [`foreground::estimate`] decides. `transparent`: non-zero on transparent pixels, which
 /// are labelled [`TRANSPARENT`] and left out of the opaque classes.
 pub fn classify(
@@ -97,25 +115,18 @@ pub fn classify(
     clf: &Classifier,
     opts: &MaterialOptions,
 ) -> Result<MaterialMap, MaterialError> {
-    let size = obs.size();
-    check_size("foreground", size, foreground.map(|m| m.size()))?;
-    check_size("transparent", size, transparent.map(|m| m.size()))?;
-    let feats = features::Features::new(obs)?;
-    let (w, h) = size;
+    let normals = match clf {
+        Classifier::Physics => normals,
+        Classifier::Knn(_) => None,
+    };
+    let Prepared { features, fg, cues } = prepare(obs, normals, foreground, transparent)?;
+    let smooth = opts.smooth_regions;
+    let metal = match clf {
+        Classifier::Physics => rule::metal_probability(&features, &cues, &fg, smooth)?,
+        Classifier::Knn(m) => knn::metal_probability(m, &features, &cues, &fg, smooth)?,
+    };
+    let (w, h) = obs.size();
     let clear = |m: Option<&Gray<u8>>, k: usize| m.is_some_and(|m| m.as_slice()[k] != 0);
-    let mut fg = match foreground {
-        Some(m) => m.as_slice().iter().map(|&v| v != 0).collect(),
-        None => foreground::estimate(&feats)?,
-    };
-    for (k, v) in fg.iter_mut().enumerate() {
-        *v &= !clear(transparent, k);
-    }
-    let cues = match normals {
-        Some(n) => cues::from_normals(obs, &feats, n)?,
-        None => cues::from_silhouette(&feats, &fg)?,
-    };
-    let Classifier::Physics = clf;
-    let metal = rule::metal_probability(&feats, &cues, &fg, opts.smooth_regions)?;
     let mut labels = Vec::with_capacity(w * h);
     let mut conf = Vec::with_capacity(w * h);
     for k in 0..w * h {
@@ -135,6 +146,34 @@ pub fn classify(
         labels: Gray::from_vec(w, h, labels).expect("size of the observation"),
         confidence: Gray::from_vec(w, h, conf).expect("size of the observation"),
     })
+}
+
+/// Features, object pixels (`foreground`, else [`foreground::estimate`], minus
+/// `transparent`) and cues (from `normals`, else from the silhouettes) of `obs`.
+pub fn prepare(
+    obs: &Observation,
+    normals: Option<&Image<f32, 3>>,
+    foreground: Option<&Gray<u8>>,
+    transparent: Option<&Gray<u8>>,
+) -> Result<Prepared, MaterialError> {
+    let size = obs.size();
+    check_size("foreground", size, foreground.map(|m| m.size()))?;
+    check_size("transparent", size, transparent.map(|m| m.size()))?;
+    let features = features::Features::new(obs)?;
+    let mut fg = match foreground {
+        Some(m) => m.as_slice().iter().map(|&v| v != 0).collect(),
+        None => foreground::estimate(&features)?,
+    };
+    if let Some(t) = transparent {
+        for (v, &t) in fg.iter_mut().zip(t.as_slice()) {
+            *v &= t == 0;
+        }
+    }
+    let cues = match normals {
+        Some(n) => cues::from_normals(obs, &features, n)?,
+        None => cues::from_silhouette(&features, &fg)?,
+    };
+    Ok(Prepared { features, fg, cues })
 }
 
 fn check_size(

@@ -95,6 +95,44 @@ impl Tally {
     }
 }
 
+impl Tally {
+    /// The rule's two region cues: the fraction of valid pixels above the metal envelope
+    /// and the DoLP-weighted phase (0 where no pixel qualifies).
+    fn region_cues(&self) -> [f32; 2] {
+        let phase = if self.rho > 0.0 {
+            self.rho_phase / self.rho
+        } else {
+            0.0
+        };
+        [self.over / self.valid.max(1.0), phase]
+    }
+}
+
+/// Per pixel, the rule's cues of its 8-connected region of `fg` ([0, 0] outside `fg`):
+/// the fraction of the region's valid pixels above the metal envelope and its
+/// DoLP-weighted phase, the evidence the rule votes on.
+pub fn region_cues(f: &Features, cues: &Cues, fg: &[bool]) -> Result<Vec<[f32; 2]>, MaterialError> {
+    let table = FresnelTable::new();
+    let (lab, count) = components(fg, f.width, f.height)?;
+    let mut t = vec![Tally::default(); count + 1];
+    for (k, &l) in lab.iter().enumerate() {
+        if l != 0 {
+            t[l as usize].add(f, cues, &table, k);
+        }
+    }
+    let per_region: Vec<[f32; 2]> = t.iter().map(Tally::region_cues).collect();
+    Ok(lab
+        .iter()
+        .map(|&l| {
+            if l != 0 {
+                per_region[l as usize]
+            } else {
+                [0.0; 2]
+            }
+        })
+        .collect())
+}
+
 /// Probability of metal from a dielectric score.
 fn metal_from(score: f32) -> f32 {
     1.0 / (1.0 + (2.0 * score.clamp(-10.0, 10.0)).exp())

@@ -6,7 +6,7 @@ use std::ffi::OsString;
 use clap::{Parser, Subcommand};
 
 use crate::error::CliError;
-use crate::{eval, run, stokes};
+use crate::{eval, run, stokes, train};
 
 /// Polarization vision tools for division-of-focal-plane cameras (Sony IMX250MZR layout:
 /// super-pixel row 0 = [90°, 45°], row 1 = [135°, 0°]).
@@ -35,6 +35,9 @@ enum Command {
     Eval(eval::EvalArgs),
     /// Joins the outputs of `eval --shard K/N` runs into one report.
     EvalMerge(eval::MergeArgs),
+    /// Trains a task's learned model on a labelled dataset (`train material DATASET --out
+    /// MODEL`), for `run --material-model MODEL`.
+    Train(train::TrainArgs),
 }
 
 /// Runs the command line `args` (program name first); `Ok(false)` when a task or sample
@@ -56,5 +59,6 @@ pub fn dispatch(cli: Cli) -> Result<bool, CliError> {
         Command::Run(args) => run::run(&args),
         Command::Eval(args) => eval::eval(&args),
         Command::EvalMerge(args) => eval::merge(&args),
+        Command::Train(args) => train::train(&args),
     }
 }

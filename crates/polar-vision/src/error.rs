@@ -110,6 +110,9 @@ pub enum CliError {
         /// The system's reason.
         reason: String,
     },
+    /// A model file cannot be used (says which file and what is wrong).
+    #[error("{0}")]
+    Model(String),
     /// The command line does not parse (or asks for help).
     #[error("{0}")]
     Usage(String),

@@ -114,13 +114,10 @@ pub struct EvalReport {
 
 /// Runs the subcommand; `Ok(false)` when a sample or a task failed.
 pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
-    let mut samples = list_samples(&args.dataset)?;
-    if !args.family.is_empty() {
-        samples.retain(|s| args.family.iter().any(|f| f == family_of(&sample_name(s))));
-        if samples.is_empty() {
-            return Err(CliError::NoSamples(args.dataset.clone()));
-        }
+    if args.run.tasks.contains(&crate::tasks::Task::Material) {
+        args.run.task.material_classifier()?;
     }
+    let samples = select_samples(&args.dataset, &args.family)?;
     let shard = args.shard.unwrap_or(Shard::ALL);
     let mine: Vec<&PathBuf> = samples
         .iter()
@@ -209,6 +206,19 @@ pub fn list_samples(dataset: &Path) -> Result<Vec<PathBuf>, CliError> {
         return Err(CliError::NoSamples(dataset.to_owned()));
     }
     Ok(out)
+}
+
+/// The sample directories of `dataset` ([`list_samples`]) of the given families (all when
+/// `families` is empty).
+pub fn select_samples(dataset: &Path, families: &[String]) -> Result<Vec<PathBuf>, CliError> {
+    let mut samples = list_samples(dataset)?;
+    if !families.is_empty() {
+        samples.retain(|s| families.iter().any(|f| f == family_of(&sample_name(s))));
+        if samples.is_empty() {
+            return Err(CliError::NoSamples(dataset.to_owned()));
+        }
+    }
+    Ok(samples)
 }
 
 fn sample_name(sample: &Path) -> String {
@@ -346,7 +356,8 @@ pub fn summary_markdown(report: &EvalReport) -> String {
     s
 }
 
-fn progress(n: usize) -> ProgressBar {
+/// A progress bar over `n` samples.
+pub fn progress(n: usize) -> ProgressBar {
     let bar = ProgressBar::new(n as u64);
     if let Ok(style) =
         ProgressStyle::with_template("{bar:40} {pos}/{len} samples, {elapsed} ({eta} left)")

@@ -1,6 +1,6 @@
 //! The polarization vision pipeline as a library: reading an observation ([`input`]), the
 //! Stokes front end ([`stokes`]), the analysis tasks ([`tasks`]) run on one sample
-//! ([`run`]) or a whole dataset ([`eval`]). The `polar-vision` binary is a thin shell over
+//! ([`run`]) or a whole dataset ([`eval`]), and training learned models ([`train`]). The `polar-vision` binary is a thin shell over
 //! these modules, one per subcommand.
 
 pub mod cli;
@@ -13,3 +13,4 @@ pub mod run;
 pub mod stokes;
 pub mod task_options;
 pub mod tasks;
+pub mod train;

@@ -1,6 +1,13 @@
 //! The options of the tasks (shared by `run` and `eval`) and the dispatch to each task.
 
+use std::path::PathBuf;
+use std::sync::Arc;
+
 use clap::Args;
+use polar_material::Classifier;
+use polar_material::knn::KnnClassifier;
+
+use crate::error::CliError;
 use polar_dehaze::Method as DehazeMethod;
 use polar_shape::{Integrator, Method};
 
@@ -37,6 +44,33 @@ pub struct TaskArgs {
     #[arg(verbatim_doc_comment)]
     #[arg(long, value_name = "NAME", default_value = "polarization", value_parser = parse_name::<DehazeMethod>)]
     pub dehaze_method: DehazeMethod,
+    /// Material classification by k nearest neighbours with this model file (made by
+    /// `polar-vision train material`), or `builtin` for the model shipped with the program
+    /// (trained on datasets-synth/suites/material-train.toml). Default: the physics rule,
+    /// which needs no training.
+    #[arg(long, value_name = "FILE")]
+    pub material_model: Option<PathBuf>,
+}
+
+/// The `--material-model` value naming the model compiled into the program.
+pub const BUILTIN_MODEL: &str = "builtin";
+
+impl TaskArgs {
+    /// The material classifier the options select; a model file that cannot be used is an
+    /// error naming it (checked before any sample is read).
+    pub fn material_classifier(&self) -> Result<Classifier, CliError> {
+        let Some(path) = &self.material_model else {
+            return Ok(Classifier::Physics);
+        };
+        let clf = if path.as_os_str() == BUILTIN_MODEL {
+            KnnClassifier::from_bytes(polar_material::knn::BUILTIN_MODEL, path)
+        } else {
+            KnnClassifier::load(path)
+        };
+        Ok(Classifier::Knn(Arc::new(clf.map_err(|e| {
+            CliError::Model(format!("--material-model: {e}"))
+        })?)))
+    }
 }
 
 fn parse_name<T: std::str::FromStr>(s: &str) -> Result<T, String>

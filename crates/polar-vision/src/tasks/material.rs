@@ -11,13 +11,14 @@ use crate::pictures::{MATERIAL_PALETTE, label_picture};
 use crate::task_options::TaskArgs;
 
 /// Runs the task with the normals and transparency mask of earlier tasks, where they ran.
-pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> {
+pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
+    let clf = args.material_classifier()?;
     let map = classify(
         ctx.obs,
         ctx.normals.as_ref(),
         None,
         ctx.transparent.as_ref(),
-        &Classifier::Physics,
+        &clf,
         &MaterialOptions::default(),
     )
     .map_err(|e| Failure::CannotRun(e.to_string()))?;
@@ -32,7 +33,13 @@ pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> 
     let picture = label_picture(&map.labels, &MATERIAL_PALETTE);
     polar_io::write_rgb8_png(picture_path(out, "material.png"), &picture).map_err(io)?;
     let mut outcome = Outcome::default();
-    if ctx.normals.is_none() {
+    if let Classifier::Knn(m) = &clf {
+        outcome.messages.push(format!(
+            "kNN classifier: k = {}, {} training points",
+            m.model().header.k,
+            m.model().header.points
+        ));
+    } else if ctx.normals.is_none() {
         outcome
             .messages
             .push("without sfp's normals: azimuths from the silhouettes".into());

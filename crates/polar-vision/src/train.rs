@@ -1,0 +1,148 @@
+//! `polar-vision train`: fits a learned model of a task on a labelled dataset and writes
+//! its model file (polar-learn's format).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use polar_io::Validation;
+use polar_learn::TrainingSummary;
+use polar_material::knn;
+use rayon::prelude::*;
+
+use crate::error::CliError;
+use crate::eval::{progress, select_samples};
+use crate::input::{InputArgs, Source, read_observation, resolve};
+
+/// The tasks that have a learned model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TrainTask {
+    /// Material classification (metal against dielectric) by k nearest neighbours, from the
+    /// labels of gt/material.png (1 dielectric, 2 metal).
+    Material,
+}
+
+/// Arguments of `polar-vision train`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Reads every sample directory of DATASET (as `eval` does) through the same input \
+path as `run` (raw.png by default), computes the task's per-pixel features on the pixels the \
+classifier takes for objects, labels them from the sample's ground truth, keeps a class-balanced \
+subsample of at most --max-points (fixed by --seed: the same command gives the same file), and \
+writes the model file: format version, task, feature list, standardization, k, the training set's \
+summary and the points. Use it with `run --material-model FILE` (or `eval`)."
+)]
+pub struct TrainArgs {
+    /// The task to train for.
+    #[arg(value_enum)]
+    pub task: TrainTask,
+    /// A dataset folder whose sub-folders are samples with ground truth (a polar-datagen
+    /// output).
+    pub dataset: PathBuf,
+    /// Where the model file goes.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Neighbours that vote.
+    #[arg(long, value_name = "K", default_value_t = 15, value_parser = clap::value_parser!(u16).range(1..))]
+    pub k: u16,
+    /// Most training points kept (half per class): the model's size and query time.
+    #[arg(long, value_name = "N", default_value_t = 4000, value_parser = clap::value_parser!(u32).range(2..=10_000_000))]
+    pub max_points: u32,
+    /// Seed of the subsample.
+    #[arg(long, value_name = "SEED", default_value_t = 1)]
+    pub seed: u64,
+    /// Use only the samples of these families (e.g. `materials`), comma-separated.
+    /// Default: all.
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub family: Vec<String>,
+    /// Which file of each sample to read (default: raw.png where there is one).
+    #[arg(long, value_enum)]
+    pub input: Option<Source>,
+    /// How to read the input.
+    #[command(flatten)]
+    pub read: InputArgs,
+}
+
+/// Runs the subcommand.
+pub fn train(args: &TrainArgs) -> Result<bool, CliError> {
+    let TrainTask::Material = args.task;
+    let start = Instant::now();
+    let samples = select_samples(&args.dataset, &args.family)?;
+    let bar = progress(samples.len());
+    let per_sample: Vec<(Vec<f32>, Vec<u8>)> = samples
+        .par_iter()
+        .map(|s| {
+            let r = material_pixels(s, args);
+            bar.inc(1);
+            r
+        })
+        .collect::<Result<_, _>>()?;
+    bar.finish_and_clear();
+    let (mut points, mut classes) = (Vec::new(), Vec::new());
+    for (p, c) in per_sample {
+        points.extend(p);
+        classes.extend(c);
+    }
+    let summary = summary(args, samples.len());
+    let model = knn::fit(
+        &points,
+        &classes,
+        usize::from(args.k),
+        args.max_points as usize,
+        args.seed,
+        summary,
+    )
+    .map_err(|e| CliError::Model(format!("{}: {e}", args.dataset.display())))?;
+    model
+        .save(&args.out)
+        .map_err(|e| CliError::Model(e.to_string()))?;
+    let s = &model.header.summary;
+    eprintln!(
+        "trained on {} samples: {:?} labelled pixels, kept {:?}; wrote {} in {:.1} s",
+        s.samples,
+        s.pixels_per_class,
+        s.points_per_class,
+        args.out.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(true)
+}
+
+/// Feature vectors and classes of one sample's labelled object pixels.
+fn material_pixels(sample: &Path, args: &TrainArgs) -> Result<(Vec<f32>, Vec<u8>), CliError> {
+    let file = resolve(sample, args.input)?;
+    let (obs, _) = read_observation(&file, &args.read)?;
+    let gt = polar_io::read_ground_truth(sample, Validation::Check)?;
+    let (mut points, mut classes) = (Vec::new(), Vec::new());
+    if let Some(labels) = &gt.material {
+        knn::add_training_pixels(&obs, labels, &mut points, &mut classes).map_err(|e| {
+            CliError::Task {
+                task: "material",
+                message: format!("{}: {e}", sample.display()),
+            }
+        })?;
+    }
+    Ok((points, classes))
+}
+
+/// The training set's summary; the settings are those that change the model's points.
+fn summary(args: &TrainArgs, samples: usize) -> TrainingSummary {
+    let settings: BTreeMap<String, String> = [
+        ("input", format!("{:?}", args.input)),
+        ("read", format!("{:?}", args.read)),
+        ("k", args.k.to_string()),
+        ("max_points", args.max_points.to_string()),
+        ("seed", args.seed.to_string()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_owned(), v))
+    .collect();
+    TrainingSummary {
+        dataset: args.dataset.display().to_string(),
+        samples,
+        families: args.family.clone(),
+        settings,
+        ..Default::default()
+    }
+}
