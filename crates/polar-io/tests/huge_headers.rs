@@ -83,9 +83,8 @@ fn tiny_exr_claiming_100000_squared_pixels_is_refused_from_its_header() {
     );
 }
 
-/// Hostile input (issue #22, seen writing the `png_mosaic` fuzz target): a colour PNG within
-/// the pixel limit was given its whole pixel buffer (800 MB for 100 MP of 16-bit RGBA) before
-/// its colour type was refused; now the header's colour type is judged first.
+/// A colour PNG is refused from its header's colour type, before any pixel buffer is
+/// allocated (a tiny file can claim 100 MP of 16-bit RGBA).
 #[test]
 fn tiny_colour_png_is_refused_from_its_header() {
     let dir = tempfile::tempdir().unwrap();
