@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use polar_io::{StagedDir, files};
 use polar_render::Polarization;
 use polar_sensor::SensorModel;
 use serde::Deserialize;
@@ -248,22 +249,11 @@ pub fn render_into(
     record: &serde_json::Value,
 ) -> Result<Polarization, Error> {
     check_sample_target(out)?;
-    let parent = parent_of(out);
     let name = sample_name(out)?;
-    let staged = parent.join(format!(".{name}.staging"));
-    if staged.exists() {
-        std::fs::remove_dir_all(&staged).map_err(Error::io(&staged))?;
-    }
-    std::fs::create_dir_all(&staged).map_err(Error::io(&staged))?;
-    let made = render(scene, &name).and_then(|result| {
-        write_sample(&staged, scene, &result, noise, record, &name)?;
-        write_pictures(&staged.join("pictures"), &result.stokes)?;
-        store::commit_dir(&parent, &staged, &name)?;
-        Ok(result.model)
-    });
-    if made.is_err() {
-        // Best effort: the error that matters is the one returned.
-        let _ = std::fs::remove_dir_all(&staged);
-    }
-    made
+    let staged = StagedDir::new(out, files::META)?;
+    let result = render(scene, &name)?;
+    write_sample(staged.path(), scene, &result, noise, record, &name)?;
+    write_pictures(&staged.path().join("pictures"), &result.stokes)?;
+    staged.commit()?;
+    Ok(result.model)
 }

@@ -91,7 +91,10 @@ pub enum Error {
         /// What failed.
         message: String,
     },
-    /// A JSON file of the dataset cannot be read or written.
+    /// A file of the dataset cannot be read or written (the message names it).
+    #[error("{0}")]
+    File(#[from] polar_io::Error),
+    /// A manifest line cannot be read or written.
     #[error("{path}: {message}")]
     Json {
         /// The JSON file.

@@ -4,6 +4,8 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
+use polar_io::{StagedDir, files};
+
 use crate::Error;
 use crate::run::{Shard, plan};
 use crate::store::{self, ManifestEntry, RunRecord};
@@ -14,7 +16,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<usize, Error> {
     let first = shards
         .first()
         .ok_or_else(|| Error::Merge("no shard directories given".into()))?;
-    let record0: RunRecord = store::read_json(&first.join(store::RUN_RECORD))?;
+    let record0: RunRecord = polar_io::read_json(first.join(store::RUN_RECORD))?;
     let suite_path = first.join(store::SUITE_COPY);
     let suite_text = std::fs::read_to_string(&suite_path).map_err(Error::io(&suite_path))?;
     let suite = Suite::parse(&suite_text).map_err(|message| Error::Suite {
@@ -24,7 +26,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<usize, Error> {
     let mut seen_shards = BTreeSet::new();
     let mut entries: Vec<(PathBuf, ManifestEntry)> = Vec::new();
     for dir in shards {
-        let record: RunRecord = store::read_json(&dir.join(store::RUN_RECORD))?;
+        let record: RunRecord = polar_io::read_json(dir.join(store::RUN_RECORD))?;
         check_same_run(&record0, &record, dir)?;
         if !seen_shards.insert(record.shard) {
             return Err(Error::Merge(format!(
@@ -102,14 +104,14 @@ fn write_merged(
         )));
     }
     for (dir, e) in entries {
-        let staged = out.join(store::STAGING).join(&e.id);
-        store::copy_dir(&dir.join(&e.id), &staged)?;
-        store::commit_dir(out, &staged, &e.id)?;
+        let staged = StagedDir::within(&out.join(&e.id), &out.join(store::STAGING), files::META)?;
+        store::copy_dir(&dir.join(&e.id), staged.path())?;
+        staged.commit()?;
     }
     let _ = std::fs::remove_dir_all(out.join(store::STAGING));
     let list: Vec<ManifestEntry> = entries.iter().map(|(_, e)| e.clone()).collect();
     store::write_manifest(out, &list)?;
-    store::write_atomic(&out.join(store::SUITE_COPY), suite_text.as_bytes())?;
+    polar_io::write_atomic(out.join(store::SUITE_COPY), suite_text.as_bytes())?;
     let all = Shard::ALL;
     let record = RunRecord {
         shard: all.k,
@@ -117,5 +119,5 @@ fn write_merged(
         expected: list.len(),
         ..record0.clone()
     };
-    store::write_json(&out.join(store::RUN_RECORD), &record)
+    Ok(polar_io::write_json(out.join(store::RUN_RECORD), &record)?)
 }

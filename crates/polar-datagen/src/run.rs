@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
+use polar_io::{StagedDir, files};
 use polar_render::Polarization;
 use rayon::prelude::*;
 
@@ -136,7 +137,7 @@ pub fn prepare_output(
     let path = opts.out.join(store::RUN_RECORD);
     let old_missing = !path.exists();
     if !old_missing {
-        let old: RunRecord = store::read_json(&path)?;
+        let old: RunRecord = polar_io::read_json(&path)?;
         if old != record {
             let reason = if old.suite_sha256 != record.suite_sha256 {
                 format!("suite '{}' with another text", old.suite)
@@ -149,12 +150,12 @@ pub fn prepare_output(
             });
         }
     } else {
-        store::write_json(&path, &record)?;
+        polar_io::write_json(&path, &record)?;
     }
     // Written after the run record, which marks the directory as a dataset of this program.
     let copy = opts.out.join(store::SUITE_COPY);
     if !copy.exists() || old_missing {
-        store::write_atomic(&copy, suite_text.as_bytes())?;
+        polar_io::write_atomic(&copy, suite_text.as_bytes())?;
     }
     Ok(PreparedRun {
         record,
@@ -223,10 +224,14 @@ fn make_one(
     params: &SampleParams,
 ) -> Result<ManifestEntry, Error> {
     let start = Instant::now();
-    let dir = store::staging_dir(out, &params.id)?;
-    let report = worker.produce(params, &dir)?;
-    let files = store::checksum_dir(&dir)?;
-    store::commit_dir(out, &dir, &params.id)?;
+    let staged = StagedDir::within(
+        &out.join(&params.id),
+        &out.join(store::STAGING),
+        files::META,
+    )?;
+    let report = worker.produce(params, staged.path())?;
+    let files = store::checksum_dir(staged.path())?;
+    staged.commit()?;
     Ok(ManifestEntry {
         id: params.id.clone(),
         seed: params.seed,

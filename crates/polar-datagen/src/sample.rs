@@ -59,7 +59,8 @@ pub fn sensor_model(noise: &NoiseLevel, stokes: &StokesImage, seed: u64) -> Sens
     let quantum_efficiency = SensorModel::imx250mzr().quantum_efficiency;
     let max_dn = f64::from((1u32 << noise.bits) - 1);
     let s0 = stokes.channel(0);
-    let level = polar_sensor::picture::quantile(&s0, EXPOSURE_QUANTILE).map_or(0.0, f64::from);
+    let level = polar_image::quantile(s0.as_slice().iter().copied(), EXPOSURE_QUANTILE)
+        .map_or(0.0, f64::from);
     let electrons_per_unit = if level > 0.0 {
         EXPOSURE_TARGET * noise.full_well_e / level
     } else {
@@ -194,7 +195,10 @@ pub fn write_sample(
         exposed.saturated_count,
         scene_meta,
     );
-    crate::store::write_json(&dir.join("meta.json"), &meta)
+    Ok(polar_io::write_json(
+        dir.join(polar_io::files::META),
+        &meta,
+    )?)
 }
 
 fn meta<'a>(
@@ -261,10 +265,11 @@ pub fn dolp_aolp(stokes: &StokesImage) -> (Gray<f32>, Gray<f32>) {
 /// Writes pictures/s0.png (viridis, 0 to the 99th percentile), dolp.png (viridis, 0..1) and
 /// aolp.png (hue = AoLP, value = DoLP) for a quick look.
 pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
-    use polar_sensor::picture::{aolp_hsv, colormap, quantile};
+    use polar_image::quantile;
+    use polar_sensor::picture::{aolp_hsv, colormap};
     std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
     let s0 = stokes.channel(0);
-    let top = quantile(&s0, EXPOSURE_QUANTILE)
+    let top = quantile(s0.as_slice().iter().copied(), EXPOSURE_QUANTILE)
         .unwrap_or(1.0)
         .max(f32::MIN_POSITIVE);
     let (dolp, aolp) = dolp_aolp(stokes);

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::fs;
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use polar_render::Polarization;
 use serde::{Deserialize, Serialize};
@@ -133,33 +133,6 @@ pub fn verify_entry(dataset: &Path, entry: &ManifestEntry) -> Result<(), Error> 
     Ok(())
 }
 
-/// Writes `bytes` to `path` atomically: a sibling temporary file, fsync, rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let tmp = path.with_extension("tmp");
-    let mut f = fs::File::create(&tmp).map_err(Error::io(&tmp))?;
-    f.write_all(bytes).map_err(Error::io(&tmp))?;
-    f.sync_all().map_err(Error::io(&tmp))?;
-    fs::rename(&tmp, path).map_err(Error::io(path))
-}
-
-/// Reads a JSON file.
-pub fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, Error> {
-    let text = fs::read_to_string(path).map_err(Error::io(path))?;
-    serde_json::from_str(&text).map_err(|e| Error::Json {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })
-}
-
-/// Writes a JSON file atomically, pretty-printed.
-pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), Error> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| Error::Json {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })?;
-    write_atomic(path, format!("{text}\n").as_bytes())
-}
-
 /// The file [`ensure_writable`] creates and removes.
 const PROBE: &str = ".write-probe";
 
@@ -274,7 +247,10 @@ pub fn write_manifest(dataset: &Path, entries: &[ManifestEntry]) -> Result<(), E
     for e in sorted {
         text.push_str(&manifest_line(dataset, e)?);
     }
-    write_atomic(&dataset.join(MANIFEST), text.as_bytes())
+    Ok(polar_io::write_atomic(
+        dataset.join(MANIFEST),
+        text.as_bytes(),
+    )?)
 }
 
 fn manifest_line(dataset: &Path, e: &ManifestEntry) -> Result<String, Error> {
@@ -296,26 +272,6 @@ pub fn append_manifest(dataset: &Path, entry: &ManifestEntry) -> Result<(), Erro
         .map_err(Error::io(&path))?;
     f.write_all(line.as_bytes()).map_err(Error::io(&path))?;
     f.sync_data().map_err(Error::io(&path))
-}
-
-/// A fresh, empty staging directory for one sample.
-pub fn staging_dir(dataset: &Path, id: &str) -> Result<PathBuf, Error> {
-    let dir = dataset.join(STAGING).join(id);
-    if dir.exists() {
-        fs::remove_dir_all(&dir).map_err(Error::io(&dir))?;
-    }
-    fs::create_dir_all(&dir).map_err(Error::io(&dir))?;
-    Ok(dir)
-}
-
-/// Moves a finished staging directory to `<dataset>/<id>` in one rename.
-pub fn commit_dir(dataset: &Path, staged: &Path, id: &str) -> Result<PathBuf, Error> {
-    let target = dataset.join(id);
-    if target.exists() {
-        fs::remove_dir_all(&target).map_err(Error::io(&target))?;
-    }
-    fs::rename(staged, &target).map_err(Error::io(&target))?;
-    Ok(target)
 }
 
 /// Recursively copies a directory (merge copies into staging, then commits with a rename).

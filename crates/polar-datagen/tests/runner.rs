@@ -13,7 +13,7 @@ use polar_datagen::suite::{SizeName, Suite};
 
 const SUITE: &str = include_str!("../../../datasets-synth/suites/tiny.toml");
 
-/// Writes the seed as bytes; fails on one id when asked; counts calls.
+/// Writes the seed as bytes (and an empty meta.json); fails on one id when asked; counts calls.
 struct Fake {
     fail_on: Option<&'static str>,
     calls: AtomicUsize,
@@ -29,7 +29,8 @@ impl SampleWorker for Fake {
             });
         }
         std::fs::create_dir_all(dir.join("gt")).unwrap();
-        std::fs::write(dir.join("raw.png"), p.seed.to_le_bytes()).unwrap();
+        std::fs::write(dir.join(polar_io::files::META), b"{}").unwrap();
+        std::fs::write(dir.join(polar_io::files::RAW), p.seed.to_le_bytes()).unwrap();
         std::fs::write(dir.join("gt/depth.exr"), p.index.to_le_bytes()).unwrap();
         Ok(WorkReport {
             model: polar_render::Polarization::None,

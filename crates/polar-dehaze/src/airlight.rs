@@ -41,7 +41,7 @@
 //! - airlight polarization at the noise level: `p` is then noise; [`crate::polarization`]
 //!   falls back when `p < min_airlight_dolp`.
 
-use polar_image::Gray;
+use polar_image::{Gray, quantile};
 use rayon::prelude::*;
 
 use crate::prep::Normalized;
@@ -360,16 +360,6 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
-/// The `q`-quantile (nearest rank) of `v`; `None` if empty.
-pub fn quantile(v: &[f32], q: f64) -> Option<f32> {
-    let mut v: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
-    Some(*v.select_nth_unstable_by(k, f32::total_cmp).1)
-}
-
 /// Estimates `alpha(x, y)`, `p` and `A_inf` (see the module doc). `None` when no usable
 /// block is polarized.
 pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
@@ -386,10 +376,10 @@ pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
         .filter(|&i| blocks.s0[i] >= DARK_LEVEL)
         .map(|i| proj[i] / blocks.s0[i])
         .collect();
-    let p = quantile(&ratio, ENVELOPE_QUANTILE)?.clamp(0.0, 1.0);
+    let p = quantile(ratio.iter().copied(), ENVELOPE_QUANTILE)?.clamp(0.0, 1.0);
     let airlight: Vec<f32> = proj.iter().map(|&v| v / p).collect();
     let a_inf = if p > 0.0 {
-        quantile(&airlight, AIRLIGHT_QUANTILE)?
+        quantile(airlight.iter().copied(), AIRLIGHT_QUANTILE)?
     } else {
         0.0
     };
@@ -410,7 +400,10 @@ pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
             let a: Vec<f32> = (0..n)
                 .map(|i| (f64::from(proj[i]) / f.at(blocks.x[i], blocks.y[i])) as f32)
                 .collect();
-            (f.at(0.0, 0.0) as f32, quantile(&a, AIRLIGHT_QUANTILE)?)
+            (
+                f.at(0.0, 0.0) as f32,
+                quantile(a.iter().copied(), AIRLIGHT_QUANTILE)?,
+            )
         }
         None => (p, a_inf),
     };

@@ -3,8 +3,10 @@
 //! Pixels are stored row-major and interleaved; row 0 is the top row.
 
 mod border;
+mod quantile;
 
 pub use border::Border;
+pub use quantile::quantile;
 use thiserror::Error;
 
 /// Errors from constructing or combining images.

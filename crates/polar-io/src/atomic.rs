@@ -20,7 +20,8 @@ pub(crate) fn temp_sibling(path: &Path) -> PathBuf {
 }
 
 /// Writes a file through `write_body`, atomically: the data goes to a temporary sibling that
-/// is renamed onto `path` only after it was written and flushed without error.
+/// is renamed onto `path` only after it was written, flushed and synced to disk without
+/// error (so a crash after the rename cannot leave an empty or partial file under `path`).
 pub(crate) fn write_file_atomic(
     path: &Path,
     write_body: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
@@ -31,6 +32,10 @@ pub(crate) fn write_file_atomic(
         let mut writer = BufWriter::new(file);
         write_body(&mut writer)?;
         writer.flush().map_err(|e| Error::io(path, "output", e))?;
+        writer
+            .get_ref()
+            .sync_all()
+            .map_err(|e| Error::io(path, "output", e))?;
         std::fs::rename(&tmp, path).map_err(|e| Error::io(path, "output", e))
     })();
     if result.is_err() {
@@ -38,4 +43,12 @@ pub(crate) fn write_file_atomic(
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// Writes `bytes` to `path` atomically (see [`write_file_atomic`]).
+pub fn write_atomic(path: impl AsRef<Path>, bytes: &[u8]) -> Result<()> {
+    let path = path.as_ref();
+    write_file_atomic(path, |w| {
+        w.write_all(bytes).map_err(|e| Error::io(path, "output", e))
+    })
 }

@@ -17,15 +17,16 @@ mod shard;
 mod staged;
 mod validate;
 
+pub use atomic::write_atomic;
 pub use error::{Error, Result};
 pub use openexr::{
     ExrCompression, exr_channel_names, read_exr, read_exr_channel, read_exr_from, write_exr,
-    write_exr_planes3, write_exr_with,
+    write_exr_plane, write_exr_planes3, write_exr_with,
 };
 pub use png::{
     BitDepth, GrayPng, check_mosaic_size, read_gray_png, read_gray_png_from, read_gray8_png,
     read_mosaic, read_mosaic_from, read_rgb8_png, write_gray_png, write_gray8_png,
-    write_gray16_png, write_rgb8_png,
+    write_gray16_png, write_rgb8_png, write_rgb8_png_rows,
 };
 pub use sample::{
     GroundTruth, MaterialLabel, Sample, TRANSPARENT_MASK_ON, files, parse_json, parse_meta,

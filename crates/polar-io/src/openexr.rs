@@ -6,6 +6,7 @@ use std::fs::File;
 use std::io::{BufReader, Read, Seek};
 use std::path::Path;
 
+use exr::image::write::channels::WritableChannels;
 use exr::prelude::{
     AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Layer, LayerAttributes,
     LineOrder, MetaData, ReadChannels, ReadLayers, SpecificChannels, Text, Vec2, WritableImage,
@@ -16,9 +17,8 @@ use polar_image::{Gray, Image};
 use crate::atomic::write_file_atomic;
 use crate::error::{Error, Result};
 
-/// Lossless compression of written EXR files. Measured on a 2448x2048 4-channel noisy float
-/// image (`benches/io.rs` and a one-off comparison, 2 loaded cores): none 0.1 s / 80 MB,
-/// RLE 0.3 s / 80 MB, ZIP per line 1.4 s / 75 MB, ZIP per 16 lines 4.8 s / 72 MB.
+/// Lossless compression of written EXR files. Noisy float data barely deflates, so ZIP
+/// saves a few percent of the bytes for several times RLE's time (`benches/io.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ExrCompression {
     /// Raw samples: fastest, largest.
@@ -65,14 +65,7 @@ pub fn write_exr_with<const C: usize>(
 ) -> Result<()> {
     let path = path.as_ref();
     let texts = channel_texts(path, &names)?;
-    let (width, height) = image.size();
-    if width == 0 || height == 0 {
-        return Err(Error::Dimensions {
-            path: path.to_owned(),
-            width,
-            height,
-        });
-    }
+    nonempty(path, image.size())?;
     let channels: Vec<AnyChannel<FlatSamples>> = texts
         .into_iter()
         .enumerate()
@@ -81,19 +74,28 @@ pub fn write_exr_with<const C: usize>(
             AnyChannel::new(name, FlatSamples::F32(plane))
         })
         .collect();
-    let layer = Layer::new(
-        (width, height),
-        LayerAttributes::default(),
-        compression.encoding(),
-        AnyChannels::sort(channels.into()),
-    );
-    let exr_image = exr::prelude::Image::from_layer(layer);
-    write_file_atomic(path, |writer| {
-        exr_image
-            .write()
-            .to_buffered(writer)
-            .map_err(|e| exr_error(path, e))
-    })
+    let channels = AnyChannels::sort(channels.into());
+    write_image(path, &single_layer(image.size(), compression, channels))
+}
+
+/// Writes one plane as the float32 channel `name` of a single-layer EXR, atomically; the
+/// encoder reads the plane in place (the file equals [`write_exr_with`]'s of the same pixels).
+pub fn write_exr_plane(
+    path: impl AsRef<Path>,
+    plane: &Gray<f32>,
+    name: &str,
+    compression: ExrCompression,
+) -> Result<()> {
+    let path = path.as_ref();
+    let [text] = channel_texts(path, &[name])?
+        .try_into()
+        .expect("one name gives one text");
+    let width = checked_size(path, &[plane])?.0;
+    let p = plane.as_slice();
+    let channels = SpecificChannels::build()
+        .with_channel(text)
+        .with_pixel_fn(|pos: Vec2<usize>| (p[pos.y() * width + pos.x()],));
+    write_image(path, &single_layer(plane.size(), compression, channels))
 }
 
 /// Writes three planes of one size as the float32 channels `names` of a single-layer EXR,
@@ -110,22 +112,7 @@ pub fn write_exr_planes3(
     let [a, b, c] = channel_texts(path, &names)?
         .try_into()
         .expect("three names give three texts");
-    let (width, height) = planes[0].size();
-    if width == 0 || height == 0 {
-        return Err(Error::Dimensions {
-            path: path.to_owned(),
-            width,
-            height,
-        });
-    }
-    if let Some(p) = planes.iter().find(|p| p.size() != (width, height)) {
-        return Err(Error::SizeMismatch {
-            path: path.to_owned(),
-            found: p.size(),
-            expected: (width, height),
-            reference: path.to_owned(),
-        });
-    }
+    let (width, height) = checked_size(path, &planes)?;
     let [pa, pb, pc] = planes.map(|p| p.as_slice());
     let channels = SpecificChannels::build()
         .with_channel(a)
@@ -135,15 +122,57 @@ pub fn write_exr_planes3(
             let k = pos.y() * width + pos.x();
             (pa[k], pb[k], pc[k])
         });
+    write_image(path, &single_layer((width, height), compression, channels))
+}
+
+/// The common size of `planes`, refusing an empty image or planes of different sizes.
+fn checked_size(path: &Path, planes: &[&Gray<f32>]) -> Result<(usize, usize)> {
+    let (width, height) = nonempty(path, planes[0].size())?;
+    if let Some(p) = planes.iter().find(|p| p.size() != (width, height)) {
+        return Err(Error::SizeMismatch {
+            path: path.to_owned(),
+            found: p.size(),
+            expected: (width, height),
+            reference: path.to_owned(),
+        });
+    }
+    Ok((width, height))
+}
+
+/// `size`, refusing an empty image (EXR has no zero-sized data window).
+fn nonempty(path: &Path, (width, height): (usize, usize)) -> Result<(usize, usize)> {
+    if width == 0 || height == 0 {
+        return Err(Error::Dimensions {
+            path: path.to_owned(),
+            width,
+            height,
+        });
+    }
+    Ok((width, height))
+}
+
+/// One layer of `channels` as an image to write.
+fn single_layer<'c, C: WritableChannels<'c> + 'c>(
+    size: (usize, usize),
+    compression: ExrCompression,
+    channels: C,
+) -> exr::prelude::Image<Layer<C>> {
     let layer = Layer::new(
-        (width, height),
+        size,
         LayerAttributes::default(),
         compression.encoding(),
         channels,
     );
-    let exr_image = exr::prelude::Image::from_layer(layer);
+    exr::prelude::Image::from_layer(layer)
+}
+
+/// Writes `image` at `path`, atomically.
+fn write_image<'c, C: WritableChannels<'c>>(
+    path: &Path,
+    image: &'c exr::prelude::Image<Layer<C>>,
+) -> Result<()> {
     write_file_atomic(path, |writer| {
-        exr_image
+        image
             .write()
             .to_buffered(writer)
             .map_err(|e| exr_error(path, e))

@@ -3,7 +3,7 @@
 //! Mosaics, label maps and masks are grayscale; RGB is for visualisations only.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, Seek};
+use std::io::{BufRead, BufReader, Seek, Write};
 use std::path::Path;
 
 use polar_image::{Gray, Image};
@@ -148,29 +148,31 @@ pub fn read_rgb8_png(path: impl AsRef<Path>) -> Result<Image<u8, 3>> {
 
 /// Writes an 8-bit grayscale PNG, atomically.
 pub fn write_gray8_png(path: impl AsRef<Path>, image: &Gray<u8>) -> Result<()> {
-    encode(
-        path.as_ref(),
+    let bytes = image.as_slice();
+    let layout = Layout::new(
         image.size(),
-        image.as_slice(),
         png::ColorType::Grayscale,
         png::BitDepth::Eight,
-    )
+    );
+    encode(path.as_ref(), layout, |y, rows| {
+        rows.copy_from_slice(&bytes[y * layout.row_bytes..][..rows.len()]);
+    })
 }
 
 /// Writes a 16-bit grayscale PNG, atomically.
 pub fn write_gray16_png(path: impl AsRef<Path>, image: &Gray<u16>) -> Result<()> {
-    let bytes: Vec<u8> = image
-        .as_slice()
-        .iter()
-        .flat_map(|v| v.to_be_bytes())
-        .collect();
-    encode(
-        path.as_ref(),
+    let samples = image.as_slice();
+    let layout = Layout::new(
         image.size(),
-        &bytes,
         png::ColorType::Grayscale,
         png::BitDepth::Sixteen,
-    )
+    );
+    encode(path.as_ref(), layout, |y, rows| {
+        let first = y * image.width();
+        for (out, v) in rows.chunks_exact_mut(2).zip(&samples[first..]) {
+            out.copy_from_slice(&v.to_be_bytes());
+        }
+    })
 }
 
 /// Writes `png.image` at `png.bit_depth`; at 8 bits a sample above 255 gives
@@ -185,14 +187,26 @@ pub fn write_gray_png(path: impl AsRef<Path>, png: &GrayPng) -> Result<()> {
 
 /// Writes an 8-bit RGB PNG (visualisations such as the AoLP/DoLP picture), atomically.
 pub fn write_rgb8_png(path: impl AsRef<Path>, image: &Image<u8, 3>) -> Result<()> {
-    encode(
-        path.as_ref(),
-        image.size(),
-        image.as_slice(),
-        png::ColorType::Rgb,
-        png::BitDepth::Eight,
-    )
+    let bytes = image.as_slice();
+    write_rgb8_png_rows(path, image.size(), |y, rows| {
+        rows.copy_from_slice(&bytes[y * 3 * image.width()..][..rows.len()]);
+    })
 }
+
+/// Writes an 8-bit RGB PNG whose rows `fill(y, rows)` computes a block at a time (`rows`
+/// holds whole rows from row `y` on, a few dozen at a time), atomically: a
+/// picture computed from float planes is never held whole in memory.
+pub fn write_rgb8_png_rows(
+    path: impl AsRef<Path>,
+    size: (usize, usize),
+    fill: impl FnMut(usize, &mut [u8]),
+) -> Result<()> {
+    let layout = Layout::new(size, png::ColorType::Rgb, png::BitDepth::Eight);
+    encode(path.as_ref(), layout, fill)
+}
+
+/// Rows per block handed to a row filler: enough to fill both cores, small beside the image.
+const ROW_BLOCK: usize = 64;
 
 /// `u16` samples as `u8`, failing on the first that does not fit.
 fn narrow_to_u8(path: &Path, image: &Gray<u16>) -> Result<Gray<u8>> {
@@ -298,22 +312,45 @@ fn color_error(
     }
 }
 
-/// Encodes `bytes` (big-endian for 16 bits, as PNG stores them) at `path`, atomically.
-/// Fast deflate: mosaics are noisy, so stronger compression costs much time for few bytes.
-fn encode(
-    path: &Path,
-    (width, height): (usize, usize),
-    bytes: &[u8],
+/// Size and sample format of an image being encoded.
+#[derive(Clone, Copy)]
+struct Layout {
+    width: usize,
+    height: usize,
+    row_bytes: usize,
     color: png::ColorType,
     depth: png::BitDepth,
-) -> Result<()> {
+}
+
+impl Layout {
+    fn new((width, height): (usize, usize), color: png::ColorType, depth: png::BitDepth) -> Self {
+        let sample_bytes = if depth == png::BitDepth::Sixteen {
+            2
+        } else {
+            1
+        };
+        let row_bytes = width * color.samples() * sample_bytes;
+        Layout {
+            width,
+            height,
+            row_bytes,
+            color,
+            depth,
+        }
+    }
+}
+
+/// Encodes the rows that `fill` produces block by block (see [`write_rgb8_png_rows`]),
+/// streaming them to `path` atomically (16-bit samples big-endian, as PNG stores them).
+/// Fast deflate: mosaics are noisy, so stronger compression costs much time for few bytes.
+fn encode(path: &Path, layout: Layout, mut fill: impl FnMut(usize, &mut [u8])) -> Result<()> {
     let dims_error = || Error::Dimensions {
         path: path.to_owned(),
-        width,
-        height,
+        width: layout.width,
+        height: layout.height,
     };
-    let w = u32::try_from(width).map_err(|_| dims_error())?;
-    let h = u32::try_from(height).map_err(|_| dims_error())?;
+    let w = u32::try_from(layout.width).map_err(|_| dims_error())?;
+    let h = u32::try_from(layout.height).map_err(|_| dims_error())?;
     if w == 0 || h == 0 {
         return Err(dims_error());
     }
@@ -324,13 +361,22 @@ fn encode(
             source: std::io::Error::other(other),
         },
     };
+    let mut block = vec![0u8; layout.row_bytes * ROW_BLOCK.min(layout.height)];
     write_file_atomic(path, |writer| {
         let mut encoder = png::Encoder::new(writer, w, h);
-        encoder.set_color(color);
-        encoder.set_depth(depth);
+        encoder.set_color(layout.color);
+        encoder.set_depth(layout.depth);
         encoder.set_compression(png::Compression::Fast);
         let mut png_writer = encoder.write_header().map_err(encode_error)?;
-        png_writer.write_image_data(bytes).map_err(encode_error)?;
+        let mut stream = png_writer.stream_writer().map_err(encode_error)?;
+        for y in (0..layout.height).step_by(ROW_BLOCK) {
+            let rows = &mut block[..layout.row_bytes * ROW_BLOCK.min(layout.height - y)];
+            fill(y, rows);
+            stream
+                .write_all(rows)
+                .map_err(|e| Error::io(path, "PNG", e))?;
+        }
+        stream.finish().map_err(encode_error)?;
         png_writer.finish().map_err(encode_error)
     })
 }

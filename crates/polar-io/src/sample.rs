@@ -8,11 +8,12 @@ use std::path::{Path, PathBuf};
 use polar_image::{Gray, Image, StokesImage};
 use serde_json::{Map, Value};
 
-use crate::atomic::{temp_sibling, write_file_atomic};
+use crate::atomic::write_atomic;
 use crate::error::{Error, Result};
 use crate::png::{
     GrayPng, check_mosaic_size, read_gray8_png, read_mosaic, write_gray_png, write_gray8_png,
 };
+use crate::staged::StagedDir;
 use crate::validate::{Rule, Validation, check_channels, check_stokes, check_u8};
 use crate::{RGB_CHANNELS, STOKES_CHANNELS, Y_CHANNEL, read_exr, write_exr};
 
@@ -229,21 +230,14 @@ fn read_gt_files(dir: &Path) -> Result<GroundTruth> {
 }
 
 /// Writes `sample` as the directory `dir` (parents are created), after the checks of
-/// [`read_sample_with`] with [`Validation::Check`]. Atomic: the files go to a temporary
-/// sibling directory that then replaces `dir`, so `dir` is never seen half-written.
+/// [`read_sample_with`] with [`Validation::Check`]. Atomic through a [`StagedDir`], so `dir`
+/// is never seen half-written; an existing `dir` must be a sample (hold `meta.json`) or empty.
 pub fn write_sample(dir: impl AsRef<Path>, sample: &Sample) -> Result<()> {
     let dir = dir.as_ref();
     check_sample(dir, sample, Validation::Check)?;
-    if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, "directory", e))?;
-    }
-    let tmp = temp_sibling(dir);
-    let result = write_sample_files(&tmp, sample).and_then(|()| replace_dir(&tmp, dir));
-    if result.is_err() {
-        // Best effort: the temporary directory may be partly written or absent.
-        let _ = std::fs::remove_dir_all(&tmp);
-    }
-    result
+    let staged = StagedDir::new(dir, files::META)?;
+    write_sample_files(staged.path(), sample)?;
+    staged.commit().map(drop)
 }
 
 /// Writes any serializable value as pretty JSON (e.g. `metrics.json`), atomically.
@@ -254,9 +248,7 @@ pub fn write_json(path: impl AsRef<Path>, value: &impl serde::Serialize) -> Resu
         source,
     })?;
     text.push(b'\n');
-    write_file_atomic(path, |w| {
-        std::io::Write::write_all(w, &text).map_err(|e| Error::io(path, "JSON", e))
-    })
+    write_atomic(path, &text)
 }
 
 /// Reads a JSON file into any deserializable type.
@@ -405,7 +397,7 @@ impl SizeCheck {
     }
 }
 
-fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
+fn write_sample_files(dir: &Path, s: &Sample) -> Result<()> {
     let gt = &s.gt;
     let has_gt = gt.normal.is_some()
         || gt.depth.is_some()
@@ -414,13 +406,12 @@ fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
         || gt.clear.is_some()
         || gt.transmission.is_some()
         || gt.dehazed.is_some();
-    let mkdir = |p: &Path| std::fs::create_dir(p).map_err(|e| Error::io(p, "directory", e));
-    mkdir(tmp)?;
     if has_gt {
-        mkdir(&tmp.join("gt"))?;
+        let gt = dir.join("gt");
+        std::fs::create_dir(&gt).map_err(|e| Error::io(&gt, "directory", e))?;
     }
-    write_json(tmp.join(files::META), &s.meta)?;
-    let p = |name: &str| tmp.join(name);
+    write_json(dir.join(files::META), &s.meta)?;
+    let p = |name: &str| dir.join(name);
     if let Some(raw) = &s.raw {
         write_gray_png(p(files::RAW), raw)?;
     }
@@ -449,33 +440,4 @@ fn write_sample_files(tmp: &Path, s: &Sample) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Moves the finished directory `new` to `dir`. An existing `dir` is first moved aside and
-/// removed only after the swap, so a failure leaves either the old or the new sample.
-fn replace_dir(new: &Path, dir: &Path) -> Result<()> {
-    let rename = |from: &Path, to: &Path| {
-        std::fs::rename(from, to).map_err(|e| Error::io(dir, "directory", e))
-    };
-    if !dir.exists() {
-        return rename(new, dir);
-    }
-    if !dir.is_dir() {
-        let source = std::io::Error::new(
-            std::io::ErrorKind::AlreadyExists,
-            "exists and is not a directory",
-        );
-        return Err(Error::Io {
-            path: dir.to_owned(),
-            source,
-        });
-    }
-    let old = temp_sibling(dir);
-    rename(dir, &old)?;
-    if let Err(e) = rename(new, dir) {
-        // Put the old sample back; if even that fails, the error below still names `dir`.
-        let _ = std::fs::rename(&old, dir);
-        return Err(e);
-    }
-    std::fs::remove_dir_all(&old).map_err(|e| Error::io(&old, "directory", e))
 }

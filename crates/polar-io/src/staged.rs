@@ -25,8 +25,24 @@ impl StagedDir {
     /// the file `marker`) and creates a fresh staging folder beside it.
     pub fn new(target: &Path, marker: &'static str) -> Result<Self> {
         let target = absolute(target)?;
-        check_replaceable(&target, marker)?;
         let staging = temp_sibling(&target);
+        Self::at(target, staging, marker)
+    }
+
+    /// [`StagedDir::new`] with the staging folder at `staging_root/<target's name>` (replacing
+    /// a leftover of an interrupted run there), for a program that keeps its unfinished work
+    /// in one place it cleans up (`staging_root` must be on the target's file system).
+    pub fn within(target: &Path, staging_root: &Path, marker: &'static str) -> Result<Self> {
+        let target = absolute(target)?;
+        let staging = staging_root.join(target.file_name().unwrap_or_default());
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging).map_err(|e| Error::io(&staging, "output", e))?;
+        }
+        Self::at(target, staging, marker)
+    }
+
+    fn at(target: PathBuf, staging: PathBuf, marker: &'static str) -> Result<Self> {
+        check_replaceable(&target, marker)?;
         std::fs::create_dir_all(&staging).map_err(|e| Error::io(&staging, "output", e))?;
         Ok(Self {
             target,
@@ -215,5 +231,27 @@ mod tests {
         let got = stage_with(&out.join("..").join("out").join("."), &[MARK]).unwrap();
         assert_eq!(got, out);
         assert!(out.join(MARK).is_file());
+    }
+
+    /// `within`: a leftover of an interrupted run in the staging root is replaced, the
+    /// commit moves the set onto the target, and a failure cleans the staging folder.
+    #[test]
+    fn within_a_staging_root_replaces_leftovers_and_cleans_up() {
+        let root = tmp("within");
+        let (out, staging) = (root.join("sample-1"), root.join(".staging"));
+        std::fs::create_dir_all(staging.join("sample-1")).unwrap();
+        std::fs::write(staging.join("sample-1/leftover"), b"l").unwrap();
+        let s = StagedDir::within(&out, &staging, MARK).unwrap();
+        assert_eq!(s.path(), staging.join("sample-1"));
+        assert!(!s.path().join("leftover").exists());
+        std::fs::write(s.path().join(MARK), b"m").unwrap();
+        s.commit().unwrap();
+        assert!(out.join(MARK).is_file());
+        {
+            let s = StagedDir::within(&out, &staging, MARK).unwrap();
+            std::fs::write(s.path().join("new"), b"n").unwrap();
+        }
+        assert!(!staging.join("sample-1").exists());
+        assert!(out.join(MARK).is_file() && !out.join("new").exists());
     }
 }

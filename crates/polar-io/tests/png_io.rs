@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use polar_image::{Gray, Image};
 use polar_io::{
     BitDepth, Error, GrayPng, read_gray_png, read_gray8_png, read_mosaic, read_rgb8_png,
-    write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png,
+    write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png, write_rgb8_png_rows,
 };
 
 fn ramp8(width: usize, height: usize) -> Gray<u8> {
@@ -134,6 +134,38 @@ fn rgb8_round_trip_is_exact() {
     let img = Image::<u8, 3>::from_vec(5, 3, data).unwrap();
     write_rgb8_png(&path, &img).unwrap();
     assert_eq!(read_rgb8_png(&path).unwrap(), img);
+}
+
+/// Rows streamed in blocks (150 rows: whole blocks and a partial last one) arrive once
+/// each, in order, and read back exactly; so do 16-bit and 8-bit gray images of that height.
+#[test]
+fn rows_streamed_in_blocks_round_trip_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (7, 150);
+    let value = |i: usize| (i * 29 % 251) as u8;
+    let mut next_row = 0;
+    write_rgb8_png_rows(dir.path().join("rows.png"), (w, h), |y, rows| {
+        assert_eq!((y, rows.len() % (3 * w)), (next_row, 0));
+        rows.iter_mut()
+            .enumerate()
+            .for_each(|(i, b)| *b = value(y * 3 * w + i));
+        next_row += rows.len() / (3 * w);
+    })
+    .unwrap();
+    assert_eq!(next_row, h);
+    let expected = Image::<u8, 3>::from_vec(w, h, (0..w * h * 3).map(value).collect()).unwrap();
+    assert_eq!(
+        read_rgb8_png(dir.path().join("rows.png")).unwrap(),
+        expected
+    );
+    let (g8, g16) = (ramp8(w, h), ramp16(w, h));
+    write_gray8_png(dir.path().join("g8.png"), &g8).unwrap();
+    write_gray16_png(dir.path().join("g16.png"), &g16).unwrap();
+    assert_eq!(read_gray8_png(dir.path().join("g8.png")).unwrap(), g8);
+    assert_eq!(
+        read_gray_png(dir.path().join("g16.png")).unwrap().image,
+        g16
+    );
 }
 
 #[test]

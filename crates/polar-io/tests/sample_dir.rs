@@ -302,3 +302,23 @@ fn json_round_trip() {
     write_json(&path, &v).unwrap();
     assert_eq!(read_json::<Value>(&path).unwrap(), v);
 }
+
+/// A folder that is not a sample (no meta.json) is refused by `write_sample`, not replaced.
+#[test]
+fn writing_onto_a_user_folder_is_refused_and_keeps_it() {
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path().join("photos");
+    std::fs::create_dir(&dir).unwrap();
+    std::fs::write(dir.join("holiday.jpg"), b"x").unwrap();
+    let err = write_sample(&dir, &full_sample()).unwrap_err().to_string();
+    assert!(
+        err.contains("photos") && err.contains("did not write"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(dir.join("holiday.jpg")).unwrap(), b"x");
+    assert_eq!(
+        std::fs::read_dir(root.path()).unwrap().count(),
+        1,
+        "no staging left"
+    );
+}

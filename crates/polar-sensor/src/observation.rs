@@ -3,11 +3,10 @@
 //! [`crate::mask`] and what is known of the camera. Nothing here depends on where the
 //! frame came from (our renderer, another one, a real sensor).
 
-use polar_image::Gray;
+use polar_image::{Gray, quantile};
 use polar_optics::pixel_frame::{CameraModel, PixelFrame};
 
 use crate::mask::{SATURATED, ZERO};
-use crate::picture::quantile;
 use crate::products::StokesPlanes;
 
 /// The input of the vision tasks.
@@ -65,16 +64,8 @@ impl Observation {
     /// there are none). Tasks divide S0 by it so that exposure and bit depth drop out.
     pub fn s0_scale(&self) -> f32 {
         let s0 = self.planes.s0.as_slice();
-        let valid: Vec<f32> = (0..s0.len())
-            .filter(|&k| self.is_valid(k))
-            .map(|k| s0[k])
-            .collect();
-        let w = valid.len();
-        Gray::from_vec(w, 1, valid)
-            .ok()
-            .and_then(|g| quantile(&g, 0.99))
-            .filter(|&q| q > 0.0)
-            .unwrap_or(1.0)
+        let valid = (0..s0.len()).filter(|&k| self.is_valid(k)).map(|k| s0[k]);
+        quantile(valid, 0.99).filter(|&q| q > 0.0).unwrap_or(1.0)
     }
 
     /// The ray and Stokes frame through the centre of pixel `(x, y)`.

@@ -19,18 +19,24 @@ pub type Rgb8 = Image<u8, 3>;
 /// `value = trunc(clip(dolp, 0, 1) · 255)`, then OpenCV's 8-bit HSV -> RGB.
 pub fn aolp_hsv(aolp: &Gray<f32>, dolp: &Gray<f32>) -> Rgb8 {
     let mut out = Rgb8::new(aolp.width(), aolp.height());
-    out.pixels_mut()
-        .par_iter_mut()
-        .zip(aolp.as_slice())
-        .zip(dolp.as_slice())
+    aolp_hsv_into(aolp.as_slice(), dolp.as_slice(), out.pixels_mut());
+    out
+}
+
+/// [`aolp_hsv`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder).
+pub fn aolp_hsv_into(aolp: &[f32], dolp: &[f32], out: &mut [[u8; 3]]) {
+    out.par_iter_mut()
+        .zip(aolp)
+        .zip(dolp)
         .for_each(|((px, &a), &d)| {
-            if a.is_finite() && d.is_finite() {
+            *px = if a.is_finite() && d.is_finite() {
                 let hue = (a.rem_euclid(std::f32::consts::PI) / std::f32::consts::PI * 179.0) as u8;
                 let value = (d.clamp(0.0, 1.0) * 255.0) as u8;
-                *px = hsv_to_rgb(hue, 255, value);
-            }
+                hsv_to_rgb(hue, 255, value)
+            } else {
+                [0; 3]
+            };
         });
-    out
 }
 
 /// OpenCV's 8-bit `HSV2RGB`: hue in `0..180` (2° steps), saturation and value in `0..=255`.
@@ -84,37 +90,25 @@ pub fn viridis(t: f32) -> [u8; 3] {
 
 /// `values` mapped linearly from `[vmin, vmax]` onto the colour map; NaN gives black.
 pub fn colormap(values: &Gray<f32>, vmin: f32, vmax: f32) -> Rgb8 {
+    let mut out = Rgb8::new(values.width(), values.height());
+    colormap_into(values.as_slice(), vmin, vmax, out.pixels_mut());
+    out
+}
+
+/// [`colormap`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder).
+pub fn colormap_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [[u8; 3]]) {
     let scale = if vmax > vmin {
         1.0 / (vmax - vmin)
     } else {
         0.0
     };
-    let mut out = Rgb8::new(values.width(), values.height());
-    out.pixels_mut()
-        .par_iter_mut()
-        .zip(values.as_slice())
-        .for_each(|(px, &v)| {
-            if v.is_finite() {
-                *px = viridis((v - vmin) * scale);
-            }
-        });
-    out
-}
-
-/// The `q`-quantile (`0..=1`) of the finite values, or `None` if there are none:
-/// a robust upper end for [`colormap`] that a few hot pixels cannot dominate.
-pub fn quantile(values: &Gray<f32>, q: f64) -> Option<f32> {
-    let mut v: Vec<f32> = values
-        .as_slice()
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    if v.is_empty() {
-        return None;
-    }
-    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
-    Some(*v.select_nth_unstable_by(k, f32::total_cmp).1)
+    out.par_iter_mut().zip(values).for_each(|(px, &v)| {
+        *px = if v.is_finite() {
+            viridis((v - vmin) * scale)
+        } else {
+            [0; 3]
+        };
+    });
 }
 
 #[cfg(test)]
@@ -139,15 +133,8 @@ mod tests {
     }
 
     #[test]
-    fn viridis_ends_and_quantile() {
+    fn viridis_ends() {
         assert_eq!(viridis(-1.0), [68, 1, 84]);
         assert_eq!(viridis(2.0), [253, 231, 37]);
-        let g = Gray::from_vec(5, 1, vec![3.0, f32::NAN, 1.0, 2.0, 100.0]).unwrap();
-        assert_eq!(quantile(&g, 0.0), Some(1.0));
-        assert_eq!(quantile(&g, 0.5), Some(3.0));
-        assert_eq!(
-            quantile(&Gray::from_vec(1, 1, vec![f32::NAN]).unwrap(), 0.5),
-            None
-        );
     }
 }

@@ -1,7 +1,7 @@
 //! 8-bit pictures of the task outputs, for people (written under `pictures/`).
 
-use polar_image::{Gray, Image};
-use polar_sensor::picture::{colormap, quantile};
+use polar_image::{Gray, Image, quantile};
+use polar_sensor::picture::colormap;
 
 /// Normals as colours: `(n + 1) / 2` per axis (x red, y green, z blue); black where none.
 pub fn normal_picture(normals: &Image<f32, 3>) -> Image<u8, 3> {
@@ -35,7 +35,9 @@ pub const MATERIAL_PALETTE: [[u8; 3]; 4] = [
 
 /// S0 as grey (0 to its 99.5th percentile) with `mask` (non-zero) tinted red.
 pub fn overlay_picture(s0: &Gray<f32>, mask: &Gray<u8>) -> Image<u8, 3> {
-    let top = quantile(s0, 0.995).filter(|&q| q > 0.0).unwrap_or(1.0);
+    let top = quantile(s0.as_slice().iter().copied(), 0.995)
+        .filter(|&q| q > 0.0)
+        .unwrap_or(1.0);
     let grey = |v: f32| (v / top).clamp(0.0, 1.0) * 255.0;
     let data: Vec<[u8; 3]> = s0
         .as_slice()
@@ -58,7 +60,7 @@ pub fn overlay_picture(s0: &Gray<f32>, mask: &Gray<u8>) -> Image<u8, 3> {
 pub fn side_by_side(same_scale: &[&Gray<f32>], extra: Option<&Gray<f32>>) -> Image<u8, 3> {
     let top = same_scale
         .first()
-        .and_then(|g| quantile(g, 0.995))
+        .and_then(|g| quantile(g.as_slice().iter().copied(), 0.995))
         .filter(|&q| q > 0.0)
         .unwrap_or(1.0);
     let mut parts: Vec<Image<u8, 3>> = same_scale.iter().map(|g| colormap(g, 0.0, top)).collect();

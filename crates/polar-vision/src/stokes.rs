@@ -1,14 +1,15 @@
 //! `polar-vision stokes`: raw mosaic -> Stokes, DoLP, AoLP and pictures.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use polar_image::Gray;
+use polar_image::{Gray, quantile};
 use polar_io::files::vision;
 use polar_io::{ExrCompression, LINEAR_STOKES_CHANNELS, Y_CHANNEL};
 use polar_sensor::StokesPlanes;
-use polar_sensor::picture::{aolp_hsv, colormap, quantile};
+use polar_sensor::picture::{aolp_hsv_into, colormap_into};
 use rayon::prelude::*;
 
 use crate::error::CliError;
@@ -115,25 +116,39 @@ pub fn write_outputs(
     }
     if want(Output::Dolp) {
         jobs.push(Box::new(move || {
-            polar_io::write_exr_with(out.join(vision::DOLP), &planes.dolp, Y_CHANNEL, rle)
+            polar_io::write_exr_plane(out.join(vision::DOLP), &planes.dolp, Y_CHANNEL[0], rle)
         }));
     }
     if want(Output::Aolp) {
         jobs.push(Box::new(move || {
-            polar_io::write_exr_with(out.join(vision::AOLP), &planes.aolp, Y_CHANNEL, rle)
+            polar_io::write_exr_plane(out.join(vision::AOLP), &planes.aolp, Y_CHANNEL[0], rle)
         }));
     }
     if want(Output::Pictures) {
+        let size = planes.s0.size();
         jobs.push(Box::new(move || {
-            let hsv = aolp_hsv(&planes.aolp, &planes.dolp);
-            polar_io::write_rgb8_png(out.join("aolp.png"), &hsv)
+            polar_io::write_rgb8_png_rows(out.join("aolp.png"), size, |y, bytes| {
+                let (px, k) = pixel_rows(size.0, y, bytes);
+                aolp_hsv_into(
+                    &planes.aolp.as_slice()[k.clone()],
+                    &planes.dolp.as_slice()[k],
+                    px,
+                );
+            })
         }));
         jobs.push(Box::new(move || {
-            polar_io::write_rgb8_png(out.join("dolp.png"), &colormap(&planes.dolp, 0.0, 1.0))
+            polar_io::write_rgb8_png_rows(out.join("dolp.png"), size, |y, bytes| {
+                let (px, k) = pixel_rows(size.0, y, bytes);
+                colormap_into(&planes.dolp.as_slice()[k], 0.0, 1.0, px);
+            })
         }));
         jobs.push(Box::new(move || {
-            let s0_max = quantile(&planes.s0, 0.995).unwrap_or(1.0);
-            polar_io::write_rgb8_png(out.join("s0.png"), &colormap(&planes.s0, 0.0, s0_max))
+            let s0 = planes.s0.as_slice();
+            let s0_max = quantile(s0.iter().copied(), 0.995).unwrap_or(1.0);
+            polar_io::write_rgb8_png_rows(out.join("s0.png"), size, |y, bytes| {
+                let (px, k) = pixel_rows(size.0, y, bytes);
+                colormap_into(&s0[k], 0.0, s0_max, px);
+            })
         }));
     }
     if let Some(mask) = mask.filter(|_| want(Output::Mask)) {
@@ -145,4 +160,12 @@ pub fn write_outputs(
         .map(|job| job())
         .collect::<Result<(), _>>()?;
     Ok(())
+}
+
+/// A block of RGB rows from row `y` on, as pixels, and the plane indices they show.
+fn pixel_rows(width: usize, y: usize, bytes: &mut [u8]) -> (&mut [[u8; 3]], Range<usize>) {
+    let pixels = bytes.as_chunks_mut::<3>().0;
+    let first = y * width;
+    let len = pixels.len();
+    (pixels, first..first + len)
 }
