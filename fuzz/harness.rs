@@ -28,8 +28,8 @@ pub struct Target {
 }
 
 /// Every target, in the order of `tools/fuzz.sh`.
-pub const TARGETS: [Target; 8] = [
-    PNG_MOSAIC, EXR_STOKES, SAMPLE, META_JSON, MANIFEST, SCENE, SUITE, VISION_RUN,
+pub const TARGETS: [Target; 9] = [
+    PNG_MOSAIC, EXR_STOKES, SAMPLE, META_JSON, MANIFEST, SCENE, SUITE, VISION_RUN, MODEL_FILE,
 ];
 
 const MIB: usize = 1 << 20;
@@ -185,6 +185,23 @@ pub const VISION_RUN: Target = Target {
         named(polar_vision::cli::run_cli(args), dir.path());
     },
     bound: |len| (SAMPLE.bound)(len) + 1024 * MAX_PIXELS,
+};
+
+/// A material model file (`--material-model FILE`) through `KnnClassifier::from_bytes`: the
+/// header is checked, then the k-d tree built. Bound: the reader checks the file's length
+/// against the header's counts before allocating, so the points and labels are at most the
+/// file's size; the JSON header as text, and the tree (points plus an index and bucket
+/// overhead per point) a few times the points.
+pub const MODEL_FILE: Target = Target {
+    name: "model_file",
+    run: |data| {
+        let path = Path::new("material-knn.bin");
+        named(
+            polar_material::knn::KnnClassifier::from_bytes(data, path),
+            path,
+        );
+    },
+    bound: |len| text_bound(len) + 8 * len,
 };
 
 /// Runs `target` on `data` and asserts its allocation bound.

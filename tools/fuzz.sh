@@ -7,7 +7,7 @@
 #   tools/fuzz.sh all [SECONDS]             run, then cmin, every target in turn
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
-targets=(png_mosaic exr_stokes sample meta_json manifest scene suite vision_run)
+targets=(png_mosaic exr_stokes sample meta_json manifest scene suite vision_run model_file)
 # No sanitizer: the code under test has no `unsafe`, and without ASan a run does about
 # twice the executions. Debug assertions (-a) turn integer overflow into a finding.
 build_flags=(--sanitizer none --debug-assertions)
@@ -41,6 +41,8 @@ seed() {
     head -n 2 "$data/manifest.jsonl" >"$c/manifest/two-lines.jsonl"
     cp datasets-synth/scenes/*.toml "$c/scene/"
     cp datasets-synth/suites/*.toml "$c/suite/"
+    cp crates/polar-material/models/material-knn.bin "$c/model_file/builtin.bin"
+    head -c 4096 crates/polar-material/models/material-knn.bin >"$c/model_file/truncated.bin"
 }
 
 run() {

@@ -202,15 +202,6 @@ impl KnnModel {
         out
     }
 
-    /// Writes the model file.
-    pub fn save(&self, path: &Path) -> Result<(), LearnError> {
-        std::fs::write(path, self.to_bytes()).map_err(|e| LearnError::Io {
-            path: path.to_owned(),
-            action: "cannot write",
-            reason: e.to_string(),
-        })
-    }
-
     /// Reads and checks a model file against what the caller computes.
     pub fn load(path: &Path, expect: Expect<'_>) -> Result<Self, LearnError> {
         let bytes = std::fs::read(path).map_err(|e| LearnError::Io {

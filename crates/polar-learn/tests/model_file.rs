@@ -46,7 +46,7 @@ fn round_trip_is_exact() {
     let dir = tempfile::tempdir().unwrap();
     let m = model(3);
     let path = dir.path().join("m.bin");
-    m.save(&path).unwrap();
+    std::fs::write(&path, m.to_bytes()).unwrap();
     let back = KnnModel::load(&path, EXPECT).unwrap();
     assert_eq!(back, m);
     assert_eq!(back.header.format_version, FORMAT_VERSION);

@@ -94,9 +94,7 @@ pub fn train(args: &TrainArgs) -> Result<bool, CliError> {
         summary,
     )
     .map_err(|e| CliError::Model(format!("{}: {e}", args.dataset.display())))?;
-    model
-        .save(&args.out)
-        .map_err(|e| CliError::Model(e.to_string()))?;
+    polar_io::write_atomic(&args.out, &model.to_bytes())?;
     let s = &model.header.summary;
     eprintln!(
         "trained on {} samples: {:?} labelled pixels, kept {:?}; wrote {} in {:.1} s",
