@@ -2,8 +2,10 @@
 //! prints the angular error of the normals over object pixels (gt material label != 0),
 //! split by the sensor noise level, with timings.
 //!
-//! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]`
-//! (default `/work/data/dev`). The Stokes planes come from the raw mosaic (residual
+//! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]
+//! [--only TEXT] [--no-speed]` (default `/work/data/dev`; samples `sfp-*` and the Mitsuba
+//! task scenes `mts-shape-*`; `--only` keeps names containing TEXT, `--no-speed` skips the
+//! timing of upscaled frames). The Stokes planes come from the raw mosaic (residual
 //! demosaicing, saturation flagged) as a camera would give them; `--exr` uses
 //! `stokes.exr` instead. `--debug DIR` writes foreground / reflection / error pictures.
 
@@ -21,6 +23,9 @@ struct Args {
     root: PathBuf,
     exr: bool,
     debug: Option<PathBuf>,
+    /// Only samples whose name contains this.
+    only: Option<String>,
+    speed: bool,
 }
 
 fn args() -> Args {
@@ -28,12 +33,16 @@ fn args() -> Args {
         root: "/work/data/dev".into(),
         exr: false,
         debug: None,
+        only: None,
+        speed: true,
     };
     let mut it = std::env::args().skip(1);
     while let Some(s) = it.next() {
         match s.as_str() {
             "--exr" => a.exr = true,
             "--debug" => a.debug = it.next().map(PathBuf::from),
+            "--only" => a.only = it.next(),
+            "--no-speed" => a.speed = false,
             _ => a.root = s.into(),
         }
     }
@@ -75,21 +84,25 @@ fn main() {
         .unwrap()
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with("sfp-"))
+            p.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
+                (n.starts_with("sfp-") || n.starts_with("mts-shape-"))
+                    && a.only.as_deref().is_none_or(|o| n.contains(o))
+            })
         })
         .collect();
     dirs.sort();
-    if let Some(first) = dirs.first() {
+    if let Some(first) = dirs.first().filter(|_| a.speed) {
         speed(first);
     }
     let methods = [Method::Local, Method::Global];
     let mut acc: std::collections::BTreeMap<(String, String), Acc> = Default::default();
     for dir in &dirs {
         let s = polar_io::read_sample(dir).unwrap();
-        let noise = s.meta["sensor"]["noise"]["name"]
+        // polar-datagen: sensor.noise.name; the Mitsuba task scenes: sensor.noise.
+        let noise_key = &s.meta["sensor"]["noise"];
+        let noise = noise_key["name"]
             .as_str()
+            .or(noise_key.as_str())
             .unwrap_or("?")
             .to_string();
         let fov = s.meta["camera"]["fov_deg"].as_f64().expect("fov_deg");

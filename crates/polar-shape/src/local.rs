@@ -7,15 +7,21 @@
 //!    smoothly toward the viewer inside. With `D` the distance to the nearest background
 //!    pixel and `R` its maximum over the object's connected component, the prior normal
 //!    has azimuth `−∇D` (smoothed) and zenith `asin(1 − D/R)` (exact for a sphere).
-//! 2. Candidates per pixel: diffuse `(AoLP, θ_d)`, `(AoLP + π, θ_d)`; specular
-//!    `(AoLP ± π/2, θ_s)` with both specular zeniths, in the per-pixel Stokes frame.
+//! 2. Candidates per pixel, in the per-pixel Stokes frame: diffuse azimuths `AoLP`,
+//!    `AoLP + π` and specular ones `AoLP ± π/2`. Observed light mixes diffuse, specular
+//!    and unpolarized parts, so DoLP only bounds the zenith (`DoLP ≤ ρ(θ)` of the
+//!    dominant part, [`crate::zenith`]); each candidate's zenith is the reference
+//!    field's zenith projected onto that feasible set
+//!    ([`ZenithModels::diffuse_mixed`](crate::zenith::ZenithModels::diffuse_mixed),
+//!    [`ZenithModels::specular_mixed`](crate::zenith::ZenithModels::specular_mixed)),
+//!    which is the pure model's zenith where the field lies outside it.
 //! 3. Iterations: each pixel takes the candidate closest to a reference field; the
 //!    field is the confidence-weighted Gaussian average of the chosen normals plus the
 //!    prior. Pixels with DoLP beyond the diffuse model or highlights
 //!    ([`Cues::surely_specular`]) only get specular candidates. Elsewhere a specular
 //!    candidate costs [`MIXED_PENALTY`]; when one still wins, the pixel is
-//!    [`ReflectionType::Mixed`]: its azimuth is the specular one and, since the DoLP of
-//!    two cancelling components says little about the zenith, its zenith is the field's.
+//!    [`ReflectionType::Mixed`] (specular azimuth in a DoLP the diffuse model also
+//!    explains).
 //! 4. Output: `normalize(c n + (1 − c) field)` with `c` the polarization confidence, so
 //!    pixels without measurable polarization take their neighbours' shape.
 //!
@@ -95,9 +101,9 @@ pub fn disambiguate(cues: &Cues, fg: &[bool]) -> Result<Estimate, ShapeError> {
 }
 
 /// The candidate of pixel `k` closest to `reference` (largest `n · reference` minus the
-/// type's cost): `(normal, type, n · reference)`. Diffuse candidates take the diffuse
-/// model's zenith, specular ones both specular branches, mixed ones the reference's
-/// zenith (module doc).
+/// type's cost): `(normal, type, n · reference)`. Each candidate's zenith is the
+/// reference's zenith projected onto the zeniths its reflection type allows for the
+/// pixel's DoLP (module doc).
 pub fn choose(
     cues: &Cues,
     k: usize,
@@ -116,25 +122,19 @@ pub fn choose(
             best = (n, kind, score);
         }
     };
+    let (_, ref_zenith) = f.angles(reference);
+    let zs = cues.models.specular_mixed(dolp, ref_zenith);
     if cues.surely_specular(k) {
-        let (lo, hi) = cues.models.specular(dolp);
         for az in [alpha + FRAC_PI_2, alpha - FRAC_PI_2] {
-            for z in [lo, hi] {
-                consider(f.normal(az, z), ReflectionType::Specular, 0.0);
-            }
+            consider(f.normal(az, zs), ReflectionType::Specular, 0.0);
         }
     } else {
-        let zd = cues.models.diffuse(dolp);
+        let zd = cues.models.diffuse_mixed(dolp, ref_zenith);
         for az in [alpha, alpha + PI] {
             consider(f.normal(az, zd), ReflectionType::Diffuse, 0.0);
         }
-        let (_, ref_zenith) = f.angles(reference);
         for az in [alpha + FRAC_PI_2, alpha - FRAC_PI_2] {
-            consider(
-                f.normal(az, ref_zenith),
-                ReflectionType::Mixed,
-                MIXED_PENALTY,
-            );
+            consider(f.normal(az, zs), ReflectionType::Mixed, MIXED_PENALTY);
         }
     }
     let (n, kind, _) = best;
