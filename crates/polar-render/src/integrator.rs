@@ -24,10 +24,10 @@ use crate::settings::{MAX_SPLIT_DEPTH, RR_DEPTH};
 use crate::tracking::Flight;
 use crate::transport::Transport;
 use crate::world::{LightSample, PickedLight, World};
-use polar_bsdf::{Bsdf, BsdfSample, Polarization};
+use polar_bsdf::{Bsdf, BsdfSample};
 use polar_optics::frame::{double_angle, rotate_stokes};
 use polar_optics::scatter::PhaseFunction;
-use polar_optics::{Mueller, Stokes, rotate_stokes_basis, stokes_basis};
+use polar_optics::{Mueller, Polarization, Stokes, rotate_stokes_basis, stokes_basis};
 use std::f64::consts::PI;
 
 /// Orthonormal shading frame: `z = n`, `x = stokes_basis(n)`, `y = z × x`.

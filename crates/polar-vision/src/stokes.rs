@@ -126,19 +126,25 @@ pub fn write_outputs(
     if want(Output::Pictures) {
         jobs.push(Box::new(move || {
             let hsv = aolp_hsv(&planes.aolp, &planes.dolp);
-            polar_io::write_rgb8_png(out.join("aolp.png"), &hsv)
+            polar_io::write_rgb8_png(out.join(vision::AOLP_PICTURE), &hsv)
         }));
         jobs.push(Box::new(move || {
-            polar_io::write_rgb8_png(out.join("dolp.png"), &colormap(&planes.dolp, 0.0, 1.0))
+            polar_io::write_rgb8_png(
+                out.join(vision::DOLP_PICTURE),
+                &colormap(&planes.dolp, 0.0, 1.0),
+            )
         }));
         jobs.push(Box::new(move || {
             let s0_max = quantile(&planes.s0, 0.995).unwrap_or(1.0);
-            polar_io::write_rgb8_png(out.join("s0.png"), &colormap(&planes.s0, 0.0, s0_max))
+            polar_io::write_rgb8_png(
+                out.join(vision::S0_PICTURE),
+                &colormap(&planes.s0, 0.0, s0_max),
+            )
         }));
     }
     if let Some(mask) = mask.filter(|_| want(Output::Mask)) {
         jobs.push(Box::new(move || {
-            polar_io::write_gray8_png(out.join("mask.png"), mask)
+            polar_io::write_gray8_png(out.join(vision::MASK), mask)
         }));
     }
     jobs.into_par_iter()
