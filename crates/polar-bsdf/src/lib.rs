@@ -44,6 +44,7 @@ mod sheet;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use error::Error;
+pub use geometry::{cosine_hemisphere, cosine_hemisphere_pdf};
 pub use lambertian::Lambertian;
 pub use material::{
     Checkerboard, ConductorParams, DielectricParams, LambertianParams, Material, Metal,
