@@ -189,7 +189,7 @@ fn bad_samples_are_recorded_and_the_rest_go_on() {
     let src = standard_ci().join("sfp-00000");
     for name in ["good-0", "corrupt-0", "mismatch-0"] {
         let dst = data.path().join(name);
-        std::fs::create_dir_all(dst.join("gt")).unwrap();
+        std::fs::create_dir_all(dst.join(files::GT_DIR)).unwrap();
         for f in [
             files::META,
             files::RAW,

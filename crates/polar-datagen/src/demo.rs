@@ -231,7 +231,10 @@ pub fn render_into(
     std::fs::create_dir_all(&staged).map_err(Error::io(&staged))?;
     let made = render(scene, &name).and_then(|result| {
         write_sample(&staged, scene, &result, noise, record, &name)?;
-        write_pictures(&staged.join("pictures"), &result.stokes)?;
+        write_pictures(
+            &staged.join(polar_io::files::vision::PICTURES),
+            &result.stokes,
+        )?;
         store::commit_dir(&parent, &staged, &name)?;
         Ok(result.model)
     });

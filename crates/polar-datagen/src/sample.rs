@@ -289,7 +289,8 @@ pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
         (vision::AOLP_PICTURE, aolp_hsv(&aolp, &dolp)),
     ];
     for (name, picture) in pictures {
-        polar_io::write_rgb8_png(dir.join(name), &picture).map_err(io_err("pictures"))?;
+        polar_io::write_rgb8_png(dir.join(name), &picture)
+            .map_err(io_err(polar_io::files::vision::PICTURES))?;
     }
     Ok(())
 }

@@ -354,7 +354,7 @@ mod tests {
     #[test]
     fn checksum_dir_covers_nested_files() {
         let dir = tempfile::tempdir().unwrap();
-        fs::create_dir_all(dir.path().join("gt")).unwrap();
+        fs::create_dir_all(dir.path().join(polar_io::files::GT_DIR)).unwrap();
         fs::write(dir.path().join("gt/a.bin"), b"abc").unwrap();
         fs::write(dir.path().join(polar_io::files::META), b"{}").unwrap();
         let sums = checksum_dir(dir.path()).unwrap();

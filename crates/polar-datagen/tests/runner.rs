@@ -29,7 +29,7 @@ impl SampleWorker for Fake {
                 message: "injected failure".into(),
             });
         }
-        std::fs::create_dir_all(dir.join("gt")).unwrap();
+        std::fs::create_dir_all(dir.join(files::GT_DIR)).unwrap();
         std::fs::write(dir.join(files::RAW), p.seed.to_le_bytes()).unwrap();
         std::fs::write(dir.join(files::GT_DEPTH), p.index.to_le_bytes()).unwrap();
         Ok(WorkReport {
