@@ -20,6 +20,7 @@ const MATERIAL_CI_ACCURACY: f64 = 0.85;
 const TRANSPARENT_CI_IOU: f64 = 0.2;
 
 use common::{arg, family_mean, json, standard_ci, vision};
+use polar_io::files::{self, vision};
 
 /// Runs `eval` on `families` of the ci suite with `tasks` and returns its metrics.json.
 fn eval(families: &str, tasks: &str, jobs: &str) -> (tempfile::TempDir, serde_json::Value) {
@@ -43,7 +44,7 @@ fn eval(families: &str, tasks: &str, jobs: &str) -> (tempfile::TempDir, serde_js
         "a task failed on {families}: see {}",
         out.path().display()
     );
-    let metrics = json(&out.path().join("metrics.json"));
+    let metrics = json(&out.path().join(vision::METRICS));
     (out, metrics)
 }
 
@@ -83,7 +84,7 @@ fn train_material_then_eval_with_the_model() {
     .expect("eval completes");
     assert!(ok, "see {}", out.display());
     let acc = family_mean(
-        &json(&out.join("metrics.json")),
+        &json(&out.join(vision::METRICS)),
         "materials",
         "material",
         "metal_vs_dielectric_accuracy",
@@ -160,7 +161,12 @@ fn outputs_are_identical_whatever_the_jobs() {
     let (b, _) = eval("sfp", "sfp", "2");
     for sample in std::fs::read_dir(a.path().join("samples")).unwrap() {
         let sample = sample.unwrap().file_name();
-        for file in ["normal.exr", "depth.exr", "reflection.png", "stokes.exr"] {
+        for file in [
+            vision::NORMAL,
+            vision::DEPTH,
+            vision::REFLECTION,
+            vision::STOKES,
+        ] {
             let read = |d: &tempfile::TempDir| {
                 std::fs::read(d.path().join("samples").join(&sample).join(file)).unwrap()
             };
@@ -183,8 +189,13 @@ fn bad_samples_are_recorded_and_the_rest_go_on() {
     let src = standard_ci().join("sfp-00000");
     for name in ["good-0", "corrupt-0", "mismatch-0"] {
         let dst = data.path().join(name);
-        std::fs::create_dir_all(dst.join("gt")).unwrap();
-        for f in ["meta.json", "raw.png", "gt/normal.exr", "gt/material.png"] {
+        std::fs::create_dir_all(dst.join(files::GT_DIR)).unwrap();
+        for f in [
+            files::META,
+            files::RAW,
+            files::GT_NORMAL,
+            files::GT_MATERIAL,
+        ] {
             std::fs::copy(src.join(f), dst.join(f)).unwrap();
         }
     }
@@ -205,7 +216,7 @@ fn bad_samples_are_recorded_and_the_rest_go_on() {
         "sfp",
     ]);
     assert_eq!(ok, Ok(false), "eval completes and reports the failures");
-    let m = json(&out.path().join("metrics.json"));
+    let m = json(&out.path().join(vision::METRICS));
     let err = |s: &str| {
         m["samples"][s]["Err"]
             .as_str()
@@ -245,11 +256,11 @@ fn run_outputs_are_identical_whatever_the_threads() {
         })
         .collect();
     for file in [
-        "normal.exr",
-        "depth.exr",
-        "material.png",
-        "transparent.png",
-        "dehazed.exr",
+        vision::NORMAL,
+        vision::DEPTH,
+        vision::MATERIAL,
+        vision::TRANSPARENT,
+        vision::DEHAZED,
     ] {
         let read = |d: &tempfile::TempDir| std::fs::read(d.path().join(file)).unwrap();
         assert!(

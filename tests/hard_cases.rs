@@ -10,6 +10,7 @@ use std::path::Path;
 
 use common::{arg, vision};
 use polar_image::{Gray, Image};
+use polar_io::files;
 use polar_io::files::vision as out_files;
 
 /// A sample directory holding only `stokes.exr` made of `f(x, y) -> [S0, S1, S2]`.
@@ -22,14 +23,14 @@ fn stokes_sample(dir: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f3
         })
         .collect();
     let img = Image::<f32, 4>::from_vec(w, h, data).unwrap();
-    polar_io::write_exr(dir.join("stokes.exr"), &img, polar_io::STOKES_CHANNELS).unwrap();
+    polar_io::write_exr(dir.join(files::STOKES), &img, polar_io::STOKES_CHANNELS).unwrap();
 }
 
 /// A sample directory holding only a 16-bit `raw.png`.
 fn raw_sample(dir: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> u16) {
     std::fs::create_dir_all(dir).unwrap();
     let raw = Gray::from_vec(w, h, (0..w * h).map(|k| f(k % w, k / w)).collect()).unwrap();
-    polar_io::write_gray16_png(dir.join("raw.png"), &raw).unwrap();
+    polar_io::write_gray16_png(dir.join(files::RAW), &raw).unwrap();
 }
 
 /// A lit sphere-like blob: S0 bright in a disc, DoLP rising toward its rim.

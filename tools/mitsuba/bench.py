@@ -30,7 +30,7 @@ then one timed render (mi.render only); both renders' errors are averaged.
 Ours: the renderer's own render time (meta.json "seconds"). CPU time is
 recorded too (process time of Mitsuba's render; our whole process), and the
 ratios are printed for both clocks: wall time is the measure on an idle
-machine, CPU time the one a loaded machine distorts less (README.md).
+machine, CPU time the one a loaded machine distorts less (docs/performance-notes.md).
 
     tools/.venv/bin/python tools/mitsuba/bench.py OUT [--refs DIR] [--threads 2]
         [--spp 1,4,16,64,256,1024] [--scenes a,b] [--mitsuba-samplers a,b|all]
@@ -64,7 +64,7 @@ MITSUBA_LD = "multijitter"
 OURS_SAMPLERS = ["independent", "sobol"]
 # Reference per scene: (sampler, spp per pass, passes), the float64 mean of
 # the passes, twice (seeds 0 and 1). Passes of at most 1024 spp: one Mitsuba
-# pass of many samples drifts in float32 (README.md, "Benchmark references").
+# pass of many samples drifts in float32 (docs/performance-notes.md, "Benchmark references").
 # `haze` keeps the cross-check's references (REFERENCE_SPP, independent).
 BENCH_REFERENCE = {
     "conductor": ("multijitter", 256, 32),

@@ -12,7 +12,7 @@ An existing reference with the same spp and seed is reused unless --force.
 bench.py also renders references with a low-discrepancy sampler as the mean
 of several passes (ensure_reference's `sampler` and `passes`): the mean is
 taken in float64, because Mitsuba accumulates a pixel's samples in float32
-and a single pass of many samples drifts (README.md, "Benchmark references").
+and a single pass of many samples drifts (docs/performance-notes.md, "Benchmark references").
 """
 
 import argparse

@@ -63,7 +63,7 @@ SCENES = SURFACE_SCENES + ["haze"]
 
 # Reference spp per scene: enough for the reference's own S0 error (one render
 # against the truth) to stay near or below 1% over the sphere pixels, as
-# measured between two independent Mitsuba renders (README.md). Mitsuba picks
+# measured between two independent Mitsuba renders (docs/performance-notes.md). Mitsuba picks
 # one of the two emitters per next-event estimate, so the sun's highlight on
 # the rough sphere is what needs most samples.
 REFERENCE_SPP = {"conductor": 1024, "roughconductor": 32768, "pplastic": 16384, "dielectric": 4096, "haze": 16384}

@@ -38,7 +38,7 @@ family (the folder name without its trailing -digits) is `mts-<kind>-<noise>`:
 
 Each sample directory holds
   stokes.exr         float32 S0..S3 from Mitsuba's `stokes` integrator: its
-                     frame is the conventions' per-pixel frame (README.md here),
+                     frame is the conventions' per-pixel frame (docs/performance-notes.md),
                      so no conversion
   polarizers.exr     I0, I45, I90, I135 = 1/2 (S0 + S1 cos 2t + S2 sin 2t)
   raw.png            16-bit PNG holding right-aligned 12-bit DN, mosaic

@@ -4,9 +4,10 @@
 
 use crate::geometry::{V3, reflect, reflect_z, reflection};
 use crate::microfacet::Ggx;
-use crate::{BsdfSample, Model, Polarization};
+use crate::{BsdfSample, Model};
 use num_complex::Complex64;
 use polar_optics::Mueller;
+use polar_optics::Polarization;
 
 /// A conductor: smooth when `roughness` is `None`.
 #[derive(Clone, Copy, Debug, PartialEq)]

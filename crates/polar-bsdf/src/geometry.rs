@@ -39,8 +39,14 @@ pub(crate) fn refract(w: &V3, m: &V3, etap: f64) -> Option<V3> {
     Some(-w / etap + (cos_w / etap - cos_t) * m)
 }
 
-/// Cosine-weighted direction on the upper hemisphere (Malley's method, concentric disk).
-pub(crate) fn cosine_hemisphere(u: [f64; 2]) -> V3 {
+/// Cosine-weighted direction on the upper hemisphere (local frame, `z` up) from a point
+/// `u` of the unit square: Malley's method, projecting Shirley and Chiu's concentric map
+/// of the square onto the disk. That map keeps areas and has low distortion, so
+/// stratified and low-discrepancy points stay well spread on the hemisphere (pbrt-v4's
+/// `SampleCosineHemisphere`). The one cosine warp of the workspace (BSDFs and the
+/// renderer's light sampling).
+#[inline(always)]
+pub fn cosine_hemisphere(u: [f64; 2]) -> V3 {
     let (a, b) = (2.0 * u[0] - 1.0, 2.0 * u[1] - 1.0);
     let (r, phi) = if a == 0.0 && b == 0.0 {
         (0.0, 0.0)
@@ -54,7 +60,8 @@ pub(crate) fn cosine_hemisphere(u: [f64; 2]) -> V3 {
 }
 
 /// Solid-angle density of [`cosine_hemisphere`]: `cos θ / π` (0 below the horizon).
-pub(crate) fn cosine_hemisphere_pdf(w: &V3) -> f64 {
+#[inline(always)]
+pub fn cosine_hemisphere_pdf(w: &V3) -> f64 {
     w.z.max(0.0) * FRAC_1_PI
 }
 

@@ -2,8 +2,9 @@
 //! whatever the input.
 
 use crate::geometry::{V3, cosine_hemisphere, cosine_hemisphere_pdf, depolarizer};
-use crate::{BsdfSample, Model, Polarization};
+use crate::{BsdfSample, Model};
 use polar_optics::Mueller;
+use polar_optics::Polarization;
 use std::f64::consts::FRAC_1_PI;
 
 /// Lambertian reflector with the given albedo in `[0, 1]`.

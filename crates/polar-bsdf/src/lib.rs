@@ -44,6 +44,7 @@ mod sheet;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use error::Error;
+pub use geometry::{cosine_hemisphere, cosine_hemisphere_pdf};
 pub use lambertian::Lambertian;
 pub use material::{
     Checkerboard, ConductorParams, DielectricParams, LambertianParams, Material, Metal,
@@ -53,24 +54,7 @@ pub use plastic::Plastic;
 pub use sheet::{Sheet, SheetKind};
 
 use nalgebra::Vector3;
-use polar_optics::{Mueller, Stokes};
-
-/// The cheapest exact light-transport model a BSDF needs, ordered
-/// `None < Linear < Full` so a scene needs the maximum over its materials.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
-)]
-pub enum Polarization {
-    /// Never polarizes and passes light on depolarized (only `M00` is non-zero):
-    /// scalar transport is exact.
-    None,
-    /// Creates or changes linear polarization but never couples `S3` with
-    /// `S0..S2` (`M[3][0..3] = M[0..3][3] = 0`): 3-component Stokes is exact.
-    Linear,
-    /// May create circular polarization or convert linear to circular
-    /// (conductors, total internal reflection, retarders): full 4×4 Mueller.
-    Full,
-}
+use polar_optics::{Mueller, Polarization, Stokes};
 
 /// One sampled incident direction.
 #[derive(Clone, Debug, PartialEq)]

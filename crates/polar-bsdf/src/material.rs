@@ -15,10 +15,9 @@
 //! ```
 
 use crate::microfacet::Ggx;
-use crate::{
-    Bsdf, Conductor, Dielectric, Error, Lambertian, Plastic, Polarization, Sheet, SheetKind,
-};
+use crate::{Bsdf, Conductor, Dielectric, Error, Lambertian, Plastic, Sheet, SheetKind};
 use num_complex::Complex64;
+use polar_optics::Polarization;
 use serde::{Deserialize, Serialize};
 
 /// A scene material.

@@ -23,7 +23,8 @@ use crate::geometry::{
 };
 use crate::lobe::first_lobe_probability;
 use crate::microfacet::Ggx;
-use crate::{BsdfSample, LobeOutcome, Model, Polarization};
+use crate::{BsdfSample, LobeOutcome, Model};
+use polar_optics::Polarization;
 use polar_optics::fresnel::fresnel_amplitudes;
 use polar_optics::{Mueller, Stokes};
 use std::f64::consts::FRAC_1_PI;

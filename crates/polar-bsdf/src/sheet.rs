@@ -10,7 +10,8 @@
 //! uses the unprojected tangent and scales the retardance by `|cos θ|`.
 
 use crate::geometry::{V3, to_bsdf_bases};
-use crate::{BsdfSample, Model, Polarization};
+use crate::{BsdfSample, Model};
+use polar_optics::Polarization;
 use polar_optics::mueller::{linear_polarizer, retarder};
 use polar_optics::{Mueller, stokes_basis};
 

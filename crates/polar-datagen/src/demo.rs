@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 
 use polar_io::{StagedDir, files};
 use polar_render::Polarization;
-use polar_sensor::SensorModel;
-use serde::Deserialize;
+use polar_sensor::{SensorModel, SensorSettings};
 
 use crate::Error;
 use crate::params::{
@@ -16,7 +15,7 @@ use crate::params::{
 use crate::sample::{render, write_pictures, write_sample};
 use crate::scene::build_scene;
 use crate::store;
-use crate::suite::{FamilyKind, NoiseLevel, validate_noise};
+use crate::suite::{FamilyKind, NoiseLevel};
 
 /// The noise of the Sony IMX250MZR preset ([`SensorModel::imx250mzr`]).
 pub fn realistic_noise() -> NoiseLevel {
@@ -147,7 +146,7 @@ pub fn check_sample_target(dir: &Path) -> Result<(), Error> {
             .map_err(Error::io(dir))?
             .next()
             .is_none();
-        if !empty && !dir.join("meta.json").exists() {
+        if !empty && !dir.join(polar_io::files::META).exists() {
             return Err(Error::OutputNotWritable {
                 path: dir.to_owned(),
                 source: std::io::Error::other(
@@ -177,43 +176,18 @@ pub fn run_demo(out: &Path, width: u32, height: u32, spp: u32) -> Result<Polariz
     render_into(out, &scene, &params.noise, &record)
 }
 
-/// Sensor settings in a scene file's `[sensor]` table; absent keys take the realistic values.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SensorTable {
-    full_well_e: Option<f64>,
-    read_noise_e: Option<f64>,
-    bits: Option<u8>,
-    shot_noise: Option<bool>,
-    extinction_ratio: Option<f64>,
-}
-
-/// The noise level of a scene file's `[sensor]` table (realistic defaults), checked with
-/// the rules of a suite's `[[noise]]` level; errors name the file and the key.
-pub fn noise_from_table(table: Option<&toml::Table>, file: &Path) -> Result<NoiseLevel, Error> {
+/// The noise level of a scene's `[sensor]` settings (checked when the scene was parsed);
+/// absent keys take the realistic values.
+pub fn noise_from_settings(s: &SensorSettings) -> NoiseLevel {
     let r = realistic_noise();
-    let Some(t) = table else { return Ok(r) };
-    let s: SensorTable =
-        t.clone()
-            .try_into()
-            .map_err(|e: toml::de::Error| polar_render::Error::Parse {
-                file: file.to_owned(),
-                message: format!("[sensor]: {e}"),
-            })?;
-    let noise = NoiseLevel {
+    NoiseLevel {
         name: "scene".into(),
         full_well_e: s.full_well_e.unwrap_or(r.full_well_e),
         read_noise_e: s.read_noise_e.unwrap_or(r.read_noise_e),
         bits: s.bits.unwrap_or(r.bits),
         shot_noise: s.shot_noise.unwrap_or(r.shot_noise),
         extinction_ratio: s.extinction_ratio.or(r.extinction_ratio),
-    };
-    validate_noise(&noise).map_err(|reason| polar_render::Error::Invalid {
-        file: file.to_owned(),
-        key: "sensor".into(),
-        reason,
-    })?;
-    Ok(noise)
+    }
 }
 
 /// Loads a scene file for `render`, with `--spp` and `--seed` applied, and checks everything
@@ -224,7 +198,7 @@ pub fn load_render_scene(
     seed: Option<u64>,
 ) -> Result<(polar_render::Scene, NoiseLevel), Error> {
     let mut scene = polar_render::load_scene(file)?;
-    let noise = noise_from_table(scene.sensor.as_ref(), file)?;
+    let noise = noise_from_settings(&scene.sensor);
     let c = &scene.camera;
     for (key, v) in [("camera.width", c.width), ("camera.height", c.height)] {
         if !v.is_multiple_of(2) {
@@ -253,7 +227,7 @@ pub fn render_into(
     let staged = StagedDir::new(out, files::META)?;
     let result = render(scene, &name)?;
     write_sample(staged.path(), scene, &result, noise, record, &name)?;
-    write_pictures(&staged.path().join("pictures"), &result.stokes)?;
+    write_pictures(&staged.path().join(files::vision::PICTURES), &result.stokes)?;
     staged.commit()?;
     Ok(result.model)
 }

@@ -134,7 +134,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             println!(
                 "wrote {} ({model:?} transport); pictures in {}",
                 out.display(),
-                out.join("pictures").display()
+                out.join(polar_io::files::vision::PICTURES).display()
             );
             Ok(())
         }

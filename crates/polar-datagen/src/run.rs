@@ -202,7 +202,7 @@ fn recover(out: &Path, jobs: &[SampleParams]) -> Result<Vec<ManifestEntry>, Erro
         if !dir.exists() || kept_ids.contains(id) {
             continue;
         }
-        if !recorded.contains(id) && !dir.join("meta.json").is_file() {
+        if !recorded.contains(id) && !dir.join(polar_io::files::META).is_file() {
             return Err(Error::Sample {
                 id: (*id).to_owned(),
                 message: format!(

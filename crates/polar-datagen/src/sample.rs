@@ -4,7 +4,8 @@
 use std::path::Path;
 
 use polar_image::{Gray, Image, StokesImage};
-use polar_render::{Polarization, RenderOptions, RenderOutput, Scene};
+use polar_io::files;
+use polar_render::{FirstHit, Polarization, RenderOptions, RenderOutput, Scene};
 use polar_sensor::SensorModel;
 use serde::Serialize;
 
@@ -39,10 +40,11 @@ impl SampleWorker for RenderWorker {
     }
 }
 
-/// Renders a scene (with a medium also its clear and dehazed ground truth, see
-/// [`RenderOutput::clear`] and [`RenderOutput::dehazed`]), mapping errors to the sample id.
+/// Renders a scene with its ground truth (with a medium also the clear and dehazed views,
+/// see [`RenderOutput::clear`] and [`RenderOutput::dehazed`]), mapping errors to the sample id.
 pub fn render(scene: &Scene, id: &str) -> Result<RenderOutput, Error> {
     let opts = RenderOptions {
+        ground_truth: true,
         clear: true,
         dehazed: true,
         ..RenderOptions::default()
@@ -149,11 +151,9 @@ pub fn write_sample(
         id: id.to_owned(),
         message: e.to_string(),
     })?;
-    let gt = dir.join("gt");
-    std::fs::create_dir_all(&gt).map_err(Error::io(&gt))?;
-    polar_io::write_gray16_png(dir.join("raw.png"), &exposed.raw).map_err(io_err(id))?;
+    polar_io::write_gray16_png(dir.join(files::RAW), &exposed.raw).map_err(io_err(id))?;
     polar_io::write_exr(
-        dir.join("stokes.exr"),
+        dir.join(files::STOKES),
         &out.stokes,
         polar_io::STOKES_CHANNELS,
     )
@@ -165,28 +165,18 @@ pub fn write_sample(
             message: e.to_string(),
         })?;
     polar_io::write_exr(
-        dir.join("polarizers.exr"),
+        dir.join(files::POLARIZERS),
         &polarizers,
         polar_io::POLARIZER_CHANNELS,
     )
     .map_err(io_err(id))?;
-    polar_io::write_exr(gt.join("normal.exr"), &out.normal, polar_io::RGB_CHANNELS)
-        .map_err(io_err(id))?;
-    polar_io::write_exr(gt.join("depth.exr"), &out.depth, polar_io::Y_CHANNEL)
-        .map_err(io_err(id))?;
-    polar_io::write_gray8_png(gt.join("material.png"), &out.material).map_err(io_err(id))?;
-    polar_io::write_gray8_png(gt.join("transparent.png"), &out.transparent).map_err(io_err(id))?;
-    // Samples with a medium: the medium-free view, the transmittance and the view with
-    // the medium off the camera rays only, for dehazing.
-    for (name, image) in [
-        (polar_io::files::GT_CLEAR, &out.clear),
-        (polar_io::files::GT_TRANSMISSION, &out.transmission),
-        (polar_io::files::GT_DEHAZED, &out.dehazed),
-    ] {
-        if let Some(image) = image {
-            polar_io::write_exr(dir.join(name), image, polar_io::Y_CHANNEL).map_err(io_err(id))?;
-        }
-    }
+    let truth = out.ground_truth.as_ref().ok_or_else(|| Error::Sample {
+        id: id.to_owned(),
+        message: "rendered without ground truth".into(),
+    })?;
+    let gt = dir.join(files::GT_DIR);
+    std::fs::create_dir_all(&gt).map_err(Error::io(&gt))?;
+    write_ground_truth(dir, truth, out).map_err(io_err(id))?;
     let meta = meta(
         scene,
         out,
@@ -195,10 +185,31 @@ pub fn write_sample(
         exposed.saturated_count,
         scene_meta,
     );
-    Ok(polar_io::write_json(
-        dir.join(polar_io::files::META),
-        &meta,
-    )?)
+    Ok(polar_io::write_json(dir.join(files::META), &meta)?)
+}
+
+/// Writes the files of `gt/` (which exists): the first-hit images of `truth` and, where rendered (a medium), the
+/// medium-free view, the transmittance and the view with the medium off the camera rays
+/// only, for dehazing.
+fn write_ground_truth(dir: &Path, truth: &FirstHit, out: &RenderOutput) -> polar_io::Result<()> {
+    polar_io::write_exr(
+        dir.join(files::GT_NORMAL),
+        &truth.normal,
+        polar_io::RGB_CHANNELS,
+    )?;
+    polar_io::write_exr(dir.join(files::GT_DEPTH), &truth.depth, polar_io::Y_CHANNEL)?;
+    polar_io::write_gray8_png(dir.join(files::GT_MATERIAL), &truth.material)?;
+    polar_io::write_gray8_png(dir.join(files::GT_TRANSPARENT), &truth.transparent)?;
+    for (name, image) in [
+        (files::GT_CLEAR, &out.clear),
+        (files::GT_TRANSMISSION, &truth.transmission),
+        (files::GT_DEHAZED, &out.dehazed),
+    ] {
+        if let Some(image) = image {
+            polar_io::write_exr(dir.join(name), image, polar_io::Y_CHANNEL)?;
+        }
+    }
+    Ok(())
 }
 
 fn meta<'a>(
@@ -266,6 +277,7 @@ pub fn dolp_aolp(stokes: &StokesImage) -> (Gray<f32>, Gray<f32>) {
 /// aolp.png (hue = AoLP, value = DoLP) for a quick look.
 pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
     use polar_image::quantile;
+    use polar_io::files::vision;
     use polar_sensor::picture::{aolp_hsv, colormap};
     std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
     let s0 = stokes.channel(0);
@@ -274,12 +286,13 @@ pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
         .max(f32::MIN_POSITIVE);
     let (dolp, aolp) = dolp_aolp(stokes);
     let pictures: [(&str, Image<u8, 3>); 3] = [
-        ("s0.png", colormap(&s0, 0.0, top)),
-        ("dolp.png", colormap(&dolp, 0.0, 1.0)),
-        ("aolp.png", aolp_hsv(&aolp, &dolp)),
+        (vision::S0_PICTURE, colormap(&s0, 0.0, top)),
+        (vision::DOLP_PICTURE, colormap(&dolp, 0.0, 1.0)),
+        (vision::AOLP_PICTURE, aolp_hsv(&aolp, &dolp)),
     ];
     for (name, picture) in pictures {
-        polar_io::write_rgb8_png(dir.join(name), &picture).map_err(io_err("pictures"))?;
+        polar_io::write_rgb8_png(dir.join(name), &picture)
+            .map_err(io_err(polar_io::files::vision::PICTURES))?;
     }
     Ok(())
 }

@@ -14,12 +14,7 @@ use sha2::{Digest, Sha256};
 use crate::Error;
 use crate::params::SampleParams;
 
-/// Name of the manifest file in a dataset directory.
-pub const MANIFEST: &str = "manifest.jsonl";
-/// Name of the run record in a dataset directory.
-pub const RUN_RECORD: &str = "run.json";
-/// Copy of the suite file in a dataset directory (merge re-derives the expected ids from it).
-pub const SUITE_COPY: &str = "suite.toml";
+pub use polar_io::files::dataset::{MANIFEST, RUN_RECORD, SUITE_COPY};
 /// Hidden directory where samples are written before the atomic rename.
 pub const STAGING: &str = ".staging";
 /// Lock file of a dataset directory: a run holds an exclusive OS lock on it while it writes.
@@ -315,11 +310,14 @@ mod tests {
     #[test]
     fn checksum_dir_covers_nested_files() {
         let dir = tempfile::tempdir().unwrap();
-        fs::create_dir_all(dir.path().join("gt")).unwrap();
+        fs::create_dir_all(dir.path().join(polar_io::files::GT_DIR)).unwrap();
         fs::write(dir.path().join("gt/a.bin"), b"abc").unwrap();
-        fs::write(dir.path().join("meta.json"), b"{}").unwrap();
+        fs::write(dir.path().join(polar_io::files::META), b"{}").unwrap();
         let sums = checksum_dir(dir.path()).unwrap();
-        assert_eq!(sums.keys().collect::<Vec<_>>(), ["gt/a.bin", "meta.json"]);
+        assert_eq!(
+            sums.keys().collect::<Vec<_>>(),
+            ["gt/a.bin", polar_io::files::META]
+        );
         assert_eq!(sums["gt/a.bin"], sha256_hex(b"abc"));
     }
 }

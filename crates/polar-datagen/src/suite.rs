@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use polar_render::scene::MAX_SPP;
+use polar_sensor::SensorSettings;
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
@@ -669,23 +670,17 @@ impl Suite {
     }
 }
 
-pub(crate) fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
-    if !(n.full_well_e.is_finite() && n.full_well_e >= 1.0) {
-        return Err(format!(
-            "full_well_e = {} must be >= 1 electron",
-            n.full_well_e
-        ));
+/// Checks a noise level with the bounds of the sensor settings (`polar_sensor`); the
+/// message starts with the key.
+fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
+    SensorSettings {
+        full_well_e: Some(n.full_well_e),
+        read_noise_e: Some(n.read_noise_e),
+        bits: Some(n.bits),
+        shot_noise: Some(n.shot_noise),
+        extinction_ratio: n.extinction_ratio,
     }
-    if let Some(er) = n.extinction_ratio.filter(|er| er.is_nan() || *er < 1.0) {
-        return Err(format!("extinction_ratio = {er} must be >= 1"));
-    }
-    if !(n.read_noise_e.is_finite() && n.read_noise_e >= 0.0) {
-        return Err(format!("read_noise_e = {} must be >= 0", n.read_noise_e));
-    }
-    if !(8..=16).contains(&n.bits) {
-        return Err(format!("bits = {} must be in 8..=16", n.bits));
-    }
-    Ok(())
+    .check()
 }
 
 /// Checks one size spec; the message starts with the key (`width`, `spp`, ...).

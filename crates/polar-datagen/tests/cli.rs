@@ -1,6 +1,7 @@
 //! End-to-end behaviour of the real `polar-datagen` binary in temporary directories, with tiny
 //! images and low spp so each test takes seconds.
 
+use polar_io::files;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -56,7 +57,7 @@ fn images(dataset: &Path) -> BTreeMap<String, Vec<u8>> {
 }
 
 fn manifest_ids(dataset: &Path) -> Vec<String> {
-    let text = std::fs::read_to_string(dataset.join("manifest.jsonl")).unwrap();
+    let text = std::fs::read_to_string(dataset.join(files::dataset::MANIFEST)).unwrap();
     text.lines()
         .map(|l| {
             serde_json::from_str::<serde_json::Value>(l).unwrap()["id"]
@@ -118,7 +119,7 @@ fn a_killed_run_resumes_to_a_complete_consistent_dataset() {
         .spawn()
         .unwrap();
     let start = Instant::now();
-    let manifest = out.join("manifest.jsonl");
+    let manifest = out.join(files::dataset::MANIFEST);
     while std::fs::read_to_string(&manifest).map_or(0, |m| m.lines().count()) < 3 {
         assert!(
             start.elapsed() < Duration::from_secs(60),
@@ -139,13 +140,13 @@ fn a_killed_run_resumes_to_a_complete_consistent_dataset() {
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
         if p.is_dir() && !name.starts_with('.') {
             for f in [
-                "meta.json",
-                "raw.png",
-                "stokes.exr",
-                "polarizers.exr",
-                "gt/normal.exr",
-                "gt/depth.exr",
-                "gt/material.png",
+                files::META,
+                files::RAW,
+                files::STOKES,
+                files::POLARIZERS,
+                files::GT_NORMAL,
+                files::GT_DEPTH,
+                files::GT_MATERIAL,
             ] {
                 assert!(p.join(f).is_file(), "{name}/{f} missing after the kill");
             }
@@ -194,7 +195,7 @@ fn merge_fails_naming_a_tampered_file_or_a_missing_shard() {
     assert!(!missing.status.success());
     assert!(String::from_utf8_lossy(&missing.stderr).contains("missing shard(s) 2/2"));
     let id = &manifest_ids(&s2)[0];
-    let victim: PathBuf = s2.join(id).join("stokes.exr");
+    let victim: PathBuf = s2.join(id).join(files::STOKES);
     let mut bytes = std::fs::read(&victim).unwrap();
     let last = bytes.len() - 1;
     bytes[last] ^= 0x01;
@@ -208,7 +209,7 @@ fn merge_fails_naming_a_tampered_file_or_a_missing_shard() {
         "{err}"
     );
     assert!(
-        !merged.join("manifest.jsonl").exists(),
+        !merged.join(files::dataset::MANIFEST).exists(),
         "a failed merge wrote a manifest"
     );
 }
@@ -253,16 +254,16 @@ fn demo_writes_a_sample_with_pictures() {
     let t = tempfile::tempdir().unwrap();
     let demo = t.path().join("demo");
     run_ok(&["demo", "--out", s(&demo), "--size", "32", "--spp", "2"]);
-    for f in [
-        "meta.json",
-        "raw.png",
-        "stokes.exr",
-        "gt/normal.exr",
-        "pictures/aolp.png",
-        "pictures/dolp.png",
-        "pictures/s0.png",
-    ] {
+    for f in [files::META, files::RAW, files::STOKES, files::GT_NORMAL] {
         assert!(demo.join(f).is_file(), "demo/{f}");
+    }
+    let pictures = demo.join(files::vision::PICTURES);
+    for f in [
+        files::vision::AOLP_PICTURE,
+        files::vision::DOLP_PICTURE,
+        files::vision::S0_PICTURE,
+    ] {
+        assert!(pictures.join(f).is_file(), "demo/pictures/{f}");
     }
 }
 
@@ -331,11 +332,11 @@ fn render_is_seeded_and_rejects_bad_scene_files_before_rendering() {
         "--seed",
         "4",
     ]);
-    let raw = |d: &Path| std::fs::read(d.join("raw.png")).unwrap();
+    let raw = |d: &Path| std::fs::read(d.join(files::RAW)).unwrap();
     assert_eq!(raw(&a), raw(&b), "same seed, different raw.png");
     assert_ne!(raw(&a), raw(&c), "the seed does not reach the noise");
     let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(a.join("meta.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(a.join(files::META)).unwrap()).unwrap();
     assert_eq!(meta["sensor"]["bit_depth"], 10);
     assert_eq!(meta["spp"], 2);
 
@@ -367,9 +368,9 @@ fn polarizer_images_decode_to_the_rendered_stokes() {
     let t = tempfile::tempdir().unwrap();
     let demo = t.path().join("demo");
     run_ok(&["demo", "--out", s(&demo), "--size", "32", "--spp", "4"]);
-    let stokes = polar_io::read_exr(demo.join("stokes.exr"), polar_io::STOKES_CHANNELS).unwrap();
+    let stokes = polar_io::read_exr(demo.join(files::STOKES), polar_io::STOKES_CHANNELS).unwrap();
     let quad =
-        polar_io::read_exr(demo.join("polarizers.exr"), polar_io::POLARIZER_CHANNELS).unwrap();
+        polar_io::read_exr(demo.join(files::POLARIZERS), polar_io::POLARIZER_CHANNELS).unwrap();
     let mut s0_ratio: Option<f32> = None;
     let mut checked = 0;
     for (s, i) in stokes.pixels().iter().zip(quad.pixels()) {
@@ -431,9 +432,9 @@ fn haze_samples_carry_the_clear_view_and_the_transmission_map() {
     for id in manifest_ids(&out) {
         // read_sample checks transmission in [0, 1] and clear S0 finite and >= 0.
         let sample = polar_io::read_sample(out.join(&id)).unwrap();
-        let transmission = sample.gt.transmission.expect("gt/transmission.exr");
-        let clear = sample.gt.clear.expect("gt/clear.exr");
-        let hazy = sample.stokes.expect("stokes.exr").channel(0);
+        let transmission = sample.gt.transmission.expect(files::GT_TRANSMISSION);
+        let clear = sample.gt.clear.expect(files::GT_CLEAR);
+        let hazy = sample.stokes.expect(files::STOKES).channel(0);
         // Sight lines cross 40-60 m of haze with sigma_t >= 0.03 /m: transmittance well below 1.
         let least = transmission.as_slice().iter().copied().fold(1.0, f32::min);
         assert!(least < 0.5, "{id}: least transmittance {least}");
@@ -460,9 +461,9 @@ fn haze_samples_carry_the_dehazed_view() {
         assert!(out.join(&id).join(polar_io::files::GT_DEHAZED).is_file());
         // read_sample also checks dehazed S0 finite, >= 0 and the size of stokes.exr.
         let sample = polar_io::read_sample(out.join(&id)).unwrap();
-        let dehazed = sample.gt.dehazed.expect("gt/dehazed.exr");
-        let hazy = sample.stokes.expect("stokes.exr").channel(0);
-        let clear = sample.gt.clear.expect("gt/clear.exr");
+        let dehazed = sample.gt.dehazed.expect(files::GT_DEHAZED);
+        let hazy = sample.stokes.expect(files::STOKES).channel(0);
+        let clear = sample.gt.clear.expect(files::GT_CLEAR);
         assert_eq!(dehazed.size(), (24, 16), "{id}");
         assert!(
             dehazed
@@ -525,15 +526,18 @@ fn suite_refuses_a_folder_that_is_not_a_dataset() {
     let t = tempfile::tempdir().unwrap();
     let user = t.path().join("photos");
     std::fs::create_dir_all(user.join("sfp-00001")).unwrap();
-    std::fs::write(user.join("suite.toml"), b"mine").unwrap();
+    std::fs::write(user.join(files::dataset::SUITE_COPY), b"mine").unwrap();
     std::fs::write(user.join("sfp-00001/photo.jpg"), b"jpeg").unwrap();
     let err = fails(&["suite", TINY, "--out", s(&user), "--quiet"]);
     assert!(
         err.contains("is not a polar-datagen dataset") && err.contains("sfp-00001, suite.toml"),
         "{err}"
     );
-    assert_eq!(names(&user), ["sfp-00001", "suite.toml"]);
-    assert_eq!(std::fs::read(user.join("suite.toml")).unwrap(), b"mine");
+    assert_eq!(names(&user), ["sfp-00001", files::dataset::SUITE_COPY]);
+    assert_eq!(
+        std::fs::read(user.join(files::dataset::SUITE_COPY)).unwrap(),
+        b"mine"
+    );
     assert_eq!(names(&user.join("sfp-00001")), ["photo.jpg"]);
 }
 

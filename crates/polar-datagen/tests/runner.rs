@@ -10,6 +10,7 @@ use polar_datagen::progress::Progress;
 use polar_datagen::run::{RunOptions, SampleWorker, Shard, WorkReport, prepare_output, run_suite};
 use polar_datagen::store::{read_manifest, verify_entry};
 use polar_datagen::suite::{SizeName, Suite};
+use polar_io::files;
 
 const SUITE: &str = include_str!("../../../datasets-synth/suites/tiny.toml");
 
@@ -28,10 +29,10 @@ impl SampleWorker for Fake {
                 message: "injected failure".into(),
             });
         }
-        std::fs::create_dir_all(dir.join("gt")).unwrap();
-        std::fs::write(dir.join(polar_io::files::META), b"{}").unwrap();
-        std::fs::write(dir.join(polar_io::files::RAW), p.seed.to_le_bytes()).unwrap();
-        std::fs::write(dir.join("gt/depth.exr"), p.index.to_le_bytes()).unwrap();
+        std::fs::create_dir_all(dir.join(files::GT_DIR)).unwrap();
+        std::fs::write(dir.join(files::META), b"{}").unwrap();
+        std::fs::write(dir.join(files::RAW), p.seed.to_le_bytes()).unwrap();
+        std::fs::write(dir.join(files::GT_DEPTH), p.index.to_le_bytes()).unwrap();
         Ok(WorkReport {
             model: polar_render::Polarization::None,
             render_seconds: 0.0,
@@ -131,7 +132,7 @@ fn resume_without_run_record_remakes_the_samples_of_another_suite() {
     prepare_output(&suite, SUITE, &opts).unwrap();
     run_suite(&suite, &opts, &fake()).unwrap();
 
-    std::fs::remove_file(t.path().join("run.json")).unwrap();
+    std::fs::remove_file(t.path().join(files::dataset::RUN_RECORD)).unwrap();
     prepare_output(&suite, SUITE, &opts).unwrap();
     let same = fake();
     run_suite(&suite, &opts, &same).unwrap();
@@ -141,7 +142,7 @@ fn resume_without_run_record_remakes_the_samples_of_another_suite() {
         "same suite re-rendered"
     );
 
-    std::fs::remove_file(t.path().join("run.json")).unwrap();
+    std::fs::remove_file(t.path().join(files::dataset::RUN_RECORD)).unwrap();
     let text = SUITE.replace("seed = 7", "seed = 8");
     let other = Suite::parse(&text).unwrap();
     prepare_output(&other, &text, &opts).unwrap();
@@ -158,7 +159,7 @@ fn resume_without_run_record_remakes_the_samples_of_another_suite() {
     for p in &planned {
         let e = manifest.iter().find(|e| e.id == p.id).unwrap();
         assert_eq!(e.seed, p.seed, "{}", p.id);
-        let raw = std::fs::read(t.path().join(&p.id).join("raw.png")).unwrap();
+        let raw = std::fs::read(t.path().join(&p.id).join(files::RAW)).unwrap();
         assert_eq!(raw, p.seed.to_le_bytes(), "{}", p.id);
     }
 }

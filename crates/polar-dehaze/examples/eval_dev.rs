@@ -19,7 +19,8 @@ use polar_sensor::{DemosaicMethod, Observation, StokesPlanes};
 fn observation(dir: &Path, raw: bool, fov: f64) -> Observation {
     let camera = CameraModel::Pinhole { fov_x_deg: fov };
     if raw {
-        let png = polar_io::read_mosaic(dir.join("raw.png")).expect("raw.png");
+        let png =
+            polar_io::read_mosaic(dir.join(polar_io::files::RAW)).expect(polar_io::files::RAW);
         let planes =
             polar_sensor::stokes_planes(&png.image, DemosaicMethod::Residual).expect("demosaic");
         let flags = polar_sensor::mask::validity_mask(
@@ -30,8 +31,11 @@ fn observation(dir: &Path, raw: bool, fov: f64) -> Observation {
         );
         Observation::new(planes, camera).with_flags(flags)
     } else {
-        let img = polar_io::read_exr(dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS)
-            .expect("stokes.exr");
+        let img = polar_io::read_exr(
+            dir.join(polar_io::files::STOKES),
+            polar_io::LINEAR_STOKES_CHANNELS,
+        )
+        .expect(polar_io::files::STOKES);
         Observation::new(StokesPlanes::from_linear_stokes(&img), camera)
     }
 }
@@ -132,7 +136,7 @@ fn main() {
         let sample = polar_io::read_sample(dir).expect("sample");
         let fov = sample.meta["camera"]["fov_deg"].as_f64().unwrap_or(45.0);
         let obs = observation(dir, raw, fov);
-        let clear = sample.gt.clear.as_ref().expect("gt/clear.exr");
+        let clear = sample.gt.clear.as_ref().expect(polar_io::files::GT_CLEAR);
         // The raw path is in DN: bring the clear image to DN with the sensor's conversion.
         let dn = if raw {
             let sensor = &sample.meta["sensor"];
@@ -148,7 +152,7 @@ fn main() {
             .gt
             .transmission
             .as_ref()
-            .expect("gt/transmission.exr");
+            .expect(polar_io::files::GT_TRANSMISSION);
         let objects: Vec<bool> = match &sample.gt.material {
             Some(m) => m.as_slice().iter().map(|&l| l != 0).collect(),
             None => vec![true; clear.as_slice().len()],
@@ -208,7 +212,7 @@ fn main() {
         if raw {
             "raw.png, residual demosaicing"
         } else {
-            "stokes.exr"
+            polar_io::files::STOKES
         },
         hazy.psnr / n,
         hazy.ssim / n,

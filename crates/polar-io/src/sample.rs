@@ -25,6 +25,11 @@ pub mod files {
     pub const RAW: &str = "raw.png";
     /// Float32 S0, S1, S2, S3 in the camera frame.
     pub const STOKES: &str = "stokes.exr";
+    /// Float32 I0, I45, I90, I135: the noiseless full-resolution images behind the four
+    /// micro-polarizers (simulated samples; an addition of this project).
+    pub const POLARIZERS: &str = "polarizers.exr";
+    /// The folder of the ground-truth files below.
+    pub const GT_DIR: &str = "gt";
     /// Float32 R, G, B: unit camera-frame normal, 0 where no surface.
     pub const GT_NORMAL: &str = "gt/normal.exr";
     /// Float32 Y: distance along -z, 0 where no surface.
@@ -51,6 +56,14 @@ pub mod files {
         pub const DOLP: &str = "dolp.exr";
         /// Float32 Y: angle of linear polarization, radians in `[0, π)`.
         pub const AOLP: &str = "aolp.exr";
+        /// 8-bit RGB picture: hue = AoLP, value = DoLP (also in polar-datagen's `pictures/`).
+        pub const AOLP_PICTURE: &str = "aolp.png";
+        /// 8-bit RGB picture: viridis DoLP (also in polar-datagen's `pictures/`).
+        pub const DOLP_PICTURE: &str = "dolp.png";
+        /// 8-bit RGB picture: viridis S0 (also in polar-datagen's `pictures/`).
+        pub const S0_PICTURE: &str = "s0.png";
+        /// 8-bit validity mask of a raw input: 0 valid, 1 saturated, 2 zero S0.
+        pub const MASK: &str = "mask.png";
         /// Float32 R, G, B: unit camera-frame normals (shape from polarization).
         pub const NORMAL: &str = "normal.exr";
         /// Float32 Y: relative depth from the normals.
@@ -75,11 +88,37 @@ pub mod files {
         pub const HAZE_DEPTH: &str = "haze_depth.exr";
         /// Per-task status, timings and (with ground truth) metrics.
         pub const METRICS: &str = "metrics.json";
-        /// Folder of 8-bit pictures for people.
+        /// Folder of 8-bit pictures for people (names in [`pictures`]).
         pub const PICTURES: &str = "pictures";
+        /// The per-sample record of `polar-vision eval` that makes a rerun resume.
+        pub const EVAL_RECORD: &str = "eval.json";
         /// Marker of an output folder written by polar-vision: only a folder that holds it
         /// (or an empty one) is replaced by a later run.
         pub const MARKER: &str = ".polar-vision";
+
+        /// The 8-bit RGB pictures of the tasks, inside [`PICTURES`].
+        pub mod pictures {
+            /// Normals from polarization as colours.
+            pub const NORMAL: &str = "normal.png";
+            /// Reflection types.
+            pub const REFLECTION: &str = "reflection.png";
+            /// Material labels.
+            pub const MATERIAL: &str = "material.png";
+            /// Transparency overlay.
+            pub const TRANSPARENT: &str = "transparent.png";
+            /// Hazy, dehazed and transmission side by side.
+            pub const DEHAZE: &str = "dehaze.png";
+        }
+    }
+
+    /// What `polar-datagen suite` writes into a dataset directory beside the samples.
+    pub mod dataset {
+        /// One JSON line per sample: id, seed, parameters, sha256 of every file, timings.
+        pub const MANIFEST: &str = "manifest.jsonl";
+        /// The run record (suite, size, shards).
+        pub const RUN_RECORD: &str = "run.json";
+        /// Copy of the suite file (merge re-derives the expected ids from it).
+        pub const SUITE_COPY: &str = "suite.toml";
     }
 }
 

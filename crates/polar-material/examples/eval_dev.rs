@@ -42,11 +42,14 @@ fn load(dir: &Path, from_stokes: bool) -> Case {
         .to_owned();
     let camera = CameraModel::Pinhole { fov_x_deg: fov };
     let obs = if from_stokes {
-        let st = polar_io::read_exr(dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS)
-            .expect("stokes.exr");
+        let st = polar_io::read_exr(
+            dir.join(polar_io::files::STOKES),
+            polar_io::LINEAR_STOKES_CHANNELS,
+        )
+        .expect(polar_io::files::STOKES);
         Observation::new(StokesPlanes::from_linear_stokes(&st), camera)
     } else {
-        let raw = s.raw.expect("raw.png").image;
+        let raw = s.raw.expect(polar_io::files::RAW).image;
         let bits = meta["sensor"]["bit_depth"].as_u64().unwrap_or(16) as u32;
         let planes = stokes_planes(&raw, DemosaicMethod::Residual).expect("demosaic");
         let flags = validity_mask(&raw, (1 << bits) - 1, DemosaicMethod::Residual, &planes.s0);
@@ -56,7 +59,7 @@ fn load(dir: &Path, from_stokes: bool) -> Case {
         name: dir.file_name().unwrap().to_string_lossy().into_owned(),
         noise,
         obs,
-        truth: s.gt.material.expect("gt/material.png"),
+        truth: s.gt.material.expect(polar_io::files::GT_MATERIAL),
         normals: s.gt.normal,
     }
 }
@@ -179,7 +182,11 @@ fn main() {
         "{} materials samples from {} ({})",
         cases.len(),
         root.display(),
-        if from_stokes { "stokes.exr" } else { "raw.png" }
+        if from_stokes {
+            polar_io::files::STOKES
+        } else {
+            polar_io::files::RAW
+        }
     );
     for noise in &noises {
         println!("noise = {noise}");

@@ -18,8 +18,11 @@ use polar_sensor::{Observation, StokesPlanes};
 const SIDE: usize = 1024;
 
 fn tiled(sample: &Path) -> Observation {
-    let s = polar_io::read_exr(sample.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS)
-        .expect("a sample directory with stokes.exr");
+    let s = polar_io::read_exr(
+        sample.join(polar_io::files::STOKES),
+        polar_io::LINEAR_STOKES_CHANNELS,
+    )
+    .expect("a sample directory with stokes.exr");
     let (w, h) = s.size();
     let mut big = Image::<f32, 3>::new(SIDE, SIDE);
     for y in 0..SIDE {

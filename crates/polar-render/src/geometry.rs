@@ -174,7 +174,7 @@ pub(crate) struct Accel {
 
 /// Up to this many primitives a ray tests each directly: a BVH traversal (f32
 /// ray set-up, node tests) costs more than a few analytic tests. Measured on
-/// the one-sphere cross-check scenes: see tools/mitsuba/README.md.
+/// the one-sphere cross-check scenes: see docs/performance-notes.md.
 const BRUTE_FORCE_MAX: usize = 4;
 
 /// Self-intersection guard for rays leaving a surface, relative to the scene scale.

@@ -24,11 +24,10 @@ use crate::settings::{MAX_SPLIT_DEPTH, RR_DEPTH};
 use crate::tracking::Flight;
 use crate::transport::Transport;
 use crate::world::{LightSample, PickedLight, World};
-use polar_bsdf::{Bsdf, BsdfSample, Polarization};
+use polar_bsdf::{Bsdf, BsdfSample, cosine_hemisphere, cosine_hemisphere_pdf};
 use polar_optics::frame::{double_angle, rotate_stokes};
 use polar_optics::scatter::PhaseFunction;
-use polar_optics::{Mueller, Stokes, rotate_stokes_basis, stokes_basis};
-use std::f64::consts::PI;
+use polar_optics::{Mueller, Polarization, Stokes, rotate_stokes_basis, stokes_basis};
 
 /// Orthonormal shading frame: `z = n`, `x = stokes_basis(n)`, `y = z × x`.
 struct Frame {
@@ -168,15 +167,15 @@ impl Vertex<'_> {
         }
     }
 
-    /// The normal about which light sampling draws environment directions
+    /// The shading frame about whose normal light sampling draws environment directions
     /// cosine-weighted: at a surface whose sampling chooses between lobes (plastic,
     /// glass), where a light sample drawn from that sampling would draw the choice
     /// again, bringing back the noise the split at the camera vertex removes.
     /// Elsewhere (`None`) the environment is sampled
     /// with the vertex's own distribution ([`NextEvent::environment`]).
-    fn cosine_environment(&self) -> Option<&Vec3> {
+    fn cosine_environment(&self) -> Option<&Frame> {
         match self {
-            Vertex::Surface { bsdf, frame, .. } if bsdf.chooses_lobes() => Some(&frame.z),
+            Vertex::Surface { bsdf, frame, .. } if bsdf.chooses_lobes() => Some(frame),
             _ => None,
         }
     }
@@ -185,7 +184,8 @@ impl Vertex<'_> {
     /// this vertex, whose own sampling has density `pdf` for it (the density of
     /// [`Self::cosine_environment`], or `pdf`).
     fn environment_density(&self, wi: &Vec3, pdf: f64) -> f64 {
-        self.cosine_environment().map_or(pdf, |n| cosine_pdf(n, wi))
+        self.cosine_environment()
+            .map_or(pdf, |frame| cosine_hemisphere_pdf(&frame.to_local(wi)))
     }
 
     /// No light sampling at a vertex whose every lobe is a delta.
@@ -347,9 +347,10 @@ impl<R: Transport, P: Fn(&Mueller) -> R> NextEvent<'_, '_, R, P> {
         sum: &mut Stokes,
     ) {
         let (wi, f, in_x, pdf, w) = match self.vertex.cosine_environment() {
-            Some(n) => {
-                let wi = cosine_direction(n, u_light);
-                let pdf = self.world.environment_pdf(cosine_pdf(n, &wi));
+            Some(frame) => {
+                let local = cosine_hemisphere(u_light);
+                let wi = frame.to_world(&local);
+                let pdf = self.world.environment_pdf(cosine_hemisphere_pdf(&local));
                 if pdf <= 0.0 {
                     return;
                 }
@@ -423,20 +424,6 @@ impl<R: Transport, P: Fn(&Mueller) -> R> NextEvent<'_, '_, R, P> {
 /// `(x + ½) mod 1`, exactly (for `x` on the `2^-53` grid of `[0, 1)`; NaN stays NaN).
 fn half_shift(x: f64) -> f64 {
     if x < 0.5 { x + 0.5 } else { x - 0.5 }
-}
-
-/// Cosine-weighted direction about `n` (Malley's method), in world space.
-fn cosine_direction(n: &Vec3, u: [f64; 2]) -> Vec3 {
-    let r = u[0].sqrt();
-    let phi = 2.0 * PI * u[1];
-    let x = stokes_basis(n);
-    let y = n.cross(&x);
-    x * (r * phi.cos()) + y * (r * phi.sin()) + n * (1.0 - u[0]).max(0.0).sqrt()
-}
-
-/// Density of [`cosine_direction`] about `n`: `max(n · wi, 0) / π`.
-fn cosine_pdf(n: &Vec3, wi: &Vec3) -> f64 {
-    n.dot(wi).max(0.0) / PI
 }
 
 /// `sum += t · le · w`, with `t = None` the identity (exactly: `I · le = le`).

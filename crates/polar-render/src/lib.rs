@@ -1,7 +1,7 @@
 //! Polarized path tracer: scene description (TOML file or Rust API), geometry in
 //! an obvhs BVH, a pinhole camera, lights (area, environment, sun), a
 //! unidirectional Mueller/Stokes path tracer with NEE + MIS, and the film with
-//! first-hit ground truth, following `docs/conventions.md`.
+//! first-hit ground truth (an option of the render call), following `docs/conventions.md`.
 //!
 //! ```no_run
 //! let scene = polar_render::load_scene(std::path::Path::new("scene.toml"))?;
@@ -27,8 +27,9 @@ mod world;
 
 pub use math::Vec3;
 pub use medium::{DensityGrid, Medium};
-pub use polar_bsdf::{Material, Polarization};
-pub use render::{RenderOptions, RenderOutput, render, required_model};
+pub use polar_bsdf::Material;
+pub use polar_optics::Polarization;
+pub use render::{FirstHit, RenderOptions, RenderOutput, render, required_model};
 pub use sampler::SamplerKind;
 pub use scene::{Camera, Emission, Geometry, Light, NamedMaterial, Scene, Shape};
 pub use scene_file::{load_scene, parse_scene};

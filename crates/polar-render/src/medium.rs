@@ -5,8 +5,8 @@
 //! shapes in it (a limit: a glass object in fog holds fog too).
 
 use crate::math::Vec3;
-use polar_bsdf::Polarization;
 use polar_optics::OpticsError;
+use polar_optics::Polarization;
 use polar_optics::scatter::PhaseFunction;
 
 /// A homogeneous or grid-modulated medium in the box `[bounds_min, bounds_max]`;
@@ -157,18 +157,13 @@ impl Medium {
         self.sigma_s + self.sigma_a
     }
 
-    /// The cheapest exact transport model for this medium: full when the phase
-    /// matrix couples circular polarization (Mie), none without scattering or for a
-    /// fully depolarizing Henyey–Greenstein (`diag(p, 0, 0, 0)` in any frame),
-    /// linear otherwise.
+    /// The cheapest exact transport model for this medium: none without scattering,
+    /// else its phase function's ([`Polarization::of_phase`]).
     pub fn polarization(&self) -> Polarization {
-        match &self.phase {
-            _ if self.sigma_s == 0.0 => Polarization::None,
-            p if p.couples_circular() => Polarization::Full,
-            PhaseFunction::HenyeyGreenstein { depolarization, .. } if *depolarization == 1.0 => {
-                Polarization::None
-            }
-            _ => Polarization::Linear,
+        if self.sigma_s == 0.0 {
+            Polarization::None
+        } else {
+            Polarization::of_phase(&self.phase)
         }
     }
 

@@ -5,12 +5,12 @@ use crate::Error;
 use crate::integrator::{SplitPaths, radiance};
 use crate::sampler::PixelStreams;
 use crate::scene::{Light, Scene};
-use crate::transport::{Full, Linear, Scalar, Transport, emission_polarization};
+use crate::transport::{Full, Linear, Scalar, Transport};
 use crate::world::World;
-use polar_bsdf::{Material, Polarization};
+use polar_bsdf::Material;
 use polar_image::{Gray, Image, StokesImage};
 use polar_io::{MaterialLabel, TRANSPARENT_MASK_ON};
-use polar_optics::Stokes;
+use polar_optics::{Polarization, Stokes};
 use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -25,6 +25,9 @@ pub struct RenderOptions {
     /// Transport model to use instead of the cheapest exact one; must not be
     /// cheaper than the scene needs (that would be inexact).
     pub force_model: Option<Polarization>,
+    /// Also compute [`RenderOutput::ground_truth`] (one more ray per pixel, through its
+    /// centre, and with a medium the optical depth along it).
+    pub ground_truth: bool,
     /// With a medium, also render [`RenderOutput::clear`] (one more render of the
     /// view); ignored without a medium.
     pub clear: bool,
@@ -38,14 +41,8 @@ pub struct RenderOptions {
 pub struct RenderOutput {
     /// Stokes `S0..S3` per pixel in the conventions' camera frame.
     pub stokes: StokesImage,
-    /// Camera-frame unit normal of the first hit, facing the camera; 0 where no surface.
-    pub normal: Image<f32, 3>,
-    /// Distance along the viewing axis (camera -z) to the first hit; 0 where no surface.
-    pub depth: Gray<f32>,
-    /// Material labels ([`MaterialLabel`] values).
-    pub material: Gray<u8>,
-    /// [`TRANSPARENT_MASK_ON`] on transparent objects, else 0.
-    pub transparent: Gray<u8>,
+    /// The first-hit ground truth; `None` unless asked for ([`RenderOptions::ground_truth`]).
+    pub ground_truth: Option<FirstHit>,
     /// S0 of the same view rendered without the participating medium (same
     /// seed and samples); `None` unless asked for ([`RenderOptions::clear`]) and the
     /// scene has a medium.
@@ -58,17 +55,31 @@ pub struct RenderOutput {
     /// `t · dehazed + airlight` with `t` the camera segment's transmittance.
     /// `None` unless asked for ([`RenderOptions::dehazed`]) and the scene has a medium.
     pub dehazed: Option<Gray<f32>>,
+    /// The transport model used.
+    pub model: Polarization,
+    /// Wall-clock seconds of the render (BVH build and ground truth included; the
+    /// renders behind `clear` and `dehazed` excluded).
+    pub seconds: f64,
+    /// Samples per pixel.
+    pub spp: u32,
+}
+
+/// Ground truth of the first hit along each pixel's central ray: the `gt/` images of
+/// docs/conventions.md that do not need another render.
+#[derive(Clone, Debug)]
+pub struct FirstHit {
+    /// Camera-frame unit normal of the first hit, facing the camera; 0 where no surface.
+    pub normal: Image<f32, 3>,
+    /// Distance along the viewing axis (camera -z) to the first hit; 0 where no surface.
+    pub depth: Gray<f32>,
+    /// Material labels ([`MaterialLabel`] values).
+    pub material: Gray<u8>,
+    /// [`TRANSPARENT_MASK_ON`] on transparent objects, else 0.
+    pub transparent: Gray<u8>,
     /// Transmittance `exp(−∫ σ_t ds)` of the medium along each pixel's central ray
     /// up to its first surface (to the medium's exit if none), computed exactly;
     /// `None` when the scene has no medium.
     pub transmission: Option<Gray<f32>>,
-    /// The transport model used.
-    pub model: Polarization,
-    /// Wall-clock seconds of the render (BVH build included; the renders behind
-    /// `clear` and `dehazed` excluded).
-    pub seconds: f64,
-    /// Samples per pixel.
-    pub spp: u32,
 }
 
 /// The cheapest exact model for `scene`: the maximum over the materials on its
@@ -78,25 +89,20 @@ pub fn required_model(scene: &Scene) -> Polarization {
         .shapes
         .iter()
         .filter_map(|s| s.material)
-        .map(|m| scene.materials[m].material.bsdf([0.5, 0.5]).polarization());
+        .map(|m| scene.materials[m].material.polarization());
     let emitters = scene
         .shapes
         .iter()
         .filter_map(|s| s.emission)
-        .map(|e| emission_polarization(&e.polarization));
+        .map(|e| Polarization::of_emission(&e.polarization));
     let lights = scene.lights.iter().map(|l| match l {
         Light::Environment(e) | Light::Sun { emission: e, .. } => {
-            emission_polarization(&e.polarization)
+            Polarization::of_emission(&e.polarization)
         }
         Light::Sky(_) => Polarization::Linear,
     });
     let medium = scene.medium.iter().map(|m| m.polarization());
-    materials
-        .chain(emitters)
-        .chain(lights)
-        .chain(medium)
-        .max()
-        .unwrap_or(Polarization::None)
+    Polarization::cheapest_exact(materials.chain(emitters).chain(lights).chain(medium))
 }
 
 /// Per-pixel results of one tile.
@@ -105,11 +111,22 @@ struct TileResult {
     y0: usize,
     w: usize,
     stokes: Vec<[f32; 4]>,
-    gt: Vec<GroundTruth>,
+    /// Empty unless the pass computes ground truth.
+    gt: Vec<PixelTruth>,
 }
 
+/// What one render pass computes besides the Stokes image.
 #[derive(Clone, Copy, Default)]
-struct GroundTruth {
+struct Pass {
+    /// Take the medium off the camera segment of every path (the dehazed ground truth).
+    camera_segment_clear: bool,
+    /// Compute the first-hit ground truth of every pixel.
+    ground_truth: bool,
+}
+
+/// The first-hit ground truth of one pixel.
+#[derive(Clone, Copy, Default)]
+struct PixelTruth {
     normal: [f32; 3],
     depth: f32,
     label: MaterialLabel,
@@ -137,16 +154,33 @@ pub fn render(
         });
     }
     let start = Instant::now();
-    let tiles = render_with(scene, model, false, progress);
+    let pass = Pass {
+        ground_truth: opts.ground_truth,
+        ..Pass::default()
+    };
+    let tiles = render_with(scene, model, pass, progress);
     let seconds = start.elapsed().as_secs_f64();
-    let mut out = assemble(scene, tiles, model, seconds);
+    let (stokes, ground_truth) = assemble(scene, tiles, pass);
+    let mut out = RenderOutput {
+        stokes,
+        ground_truth,
+        clear: None,
+        dehazed: None,
+        model,
+        seconds,
+        spp: scene.settings.spp,
+    };
     if scene.medium.is_some() {
         if opts.clear {
             out.clear = Some(render_clear(scene, opts, progress));
         }
         if opts.dehazed {
-            let dehazed = assemble(scene, render_with(scene, model, true, progress), model, 0.0);
-            out.dehazed = Some(dehazed.stokes.channel(0));
+            let pass = Pass {
+                camera_segment_clear: true,
+                ..Pass::default()
+            };
+            let tiles = render_with(scene, model, pass, progress);
+            out.dehazed = Some(assemble(scene, tiles, pass).0.channel(0));
         }
     }
     Ok(out)
@@ -163,45 +197,48 @@ fn render_clear(
         ..scene.clone()
     };
     let model = opts.force_model.unwrap_or(required_model(&clear_scene));
-    let tiles = render_with(&clear_scene, model, false, progress);
-    assemble(&clear_scene, tiles, model, 0.0).stokes.channel(0)
+    let pass = Pass::default();
+    let tiles = render_with(&clear_scene, model, pass, progress);
+    assemble(&clear_scene, tiles, pass).0.channel(0)
 }
 
 /// Renders the tiles of a validated scene with transport `model`, on the best
-/// SIMD target of the CPU; `camera_segment_clear` takes the medium off the camera
-/// segment of every path (the dehazed ground truth).
+/// SIMD target of the CPU.
 fn render_with(
     scene: &Scene,
     model: Polarization,
-    camera_segment_clear: bool,
+    pass: Pass,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<TileResult> {
-    render_on(scene, model, camera_segment_clear, Arch::new(), progress)
+    render_on(scene, model, pass, Arch::new(), progress)
 }
 
 /// [`render_with`] on the SIMD target `arch`.
 fn render_on(
     scene: &Scene,
     model: Polarization,
-    camera_segment_clear: bool,
+    pass: Pass,
     arch: Arch,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<TileResult> {
     let world = World::new(scene);
-    let world = if camera_segment_clear {
+    let world = if pass.camera_segment_clear {
         world.with_camera_segment_clear()
     } else {
         world
     };
+    let gt = pass.ground_truth;
     match model {
-        Polarization::None => render_tiles::<Scalar>(&world, arch, progress),
-        Polarization::Linear => render_tiles::<Linear>(&world, arch, progress),
-        Polarization::Full => render_tiles::<Full>(&world, arch, progress),
+        Polarization::None => render_tiles::<Scalar>(&world, gt, arch, progress),
+        Polarization::Linear => render_tiles::<Linear>(&world, gt, arch, progress),
+        Polarization::Full => render_tiles::<Full>(&world, gt, arch, progress),
     }
 }
 
+/// The tiles of `world` in parallel; `ground_truth`: also each pixel's first-hit truth.
 fn render_tiles<R: Transport>(
     world: &World,
+    ground_truth: bool,
     arch: Arch,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<TileResult> {
@@ -216,6 +253,7 @@ fn render_tiles<R: Transport>(
             let tile = arch.dispatch(TileOp::<R> {
                 world,
                 origin: (x0, y0),
+                ground_truth,
                 transport: std::marker::PhantomData,
             });
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, origins.len());
@@ -234,6 +272,7 @@ fn render_tiles<R: Transport>(
 struct TileOp<'a, R> {
     world: &'a World<'a>,
     origin: (usize, usize),
+    ground_truth: bool,
     transport: std::marker::PhantomData<R>,
 }
 
@@ -242,12 +281,17 @@ impl<R: Transport> WithSimd for TileOp<'_, R> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, _: S) -> TileResult {
-        render_tile::<R>(self.world, self.origin.0, self.origin.1)
+        render_tile::<R>(self.world, self.origin, self.ground_truth)
     }
 }
 
+/// The pixels of the tile at `(x0, y0)`; `ground_truth`: also their first-hit truth.
 #[inline(always)]
-fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult {
+fn render_tile<R: Transport>(
+    world: &World,
+    (x0, y0): (usize, usize),
+    ground_truth: bool,
+) -> TileResult {
     let cam = &world.scene.camera;
     let (tw, th) = (TILE.min(cam.width - x0), TILE.min(cam.height - y0));
     let settings = &world.scene.settings;
@@ -256,7 +300,7 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
         y0,
         w: tw,
         stokes: Vec::with_capacity(tw * th),
-        gt: Vec::with_capacity(tw * th),
+        gt: Vec::with_capacity(if ground_truth { tw * th } else { 0 }),
     };
     for y in y0..y0 + th {
         for x in x0..x0 + tw {
@@ -268,7 +312,9 @@ fn render_tile<R: Transport>(world: &World, x0: usize, y0: usize) -> TileResult 
                 mean[2] as f32,
                 mean[3] as f32,
             ]);
-            tile.gt.push(ground_truth(world, x, y));
+            if ground_truth {
+                tile.gt.push(pixel_truth(world, x, y));
+            }
         }
     }
     tile
@@ -303,7 +349,7 @@ fn pixel_sum<R: Transport>(world: &World, x: usize, y: usize) -> Stokes {
 }
 
 /// First-hit ground truth along the ray through the pixel centre.
-fn ground_truth(world: &World, x: usize, y: usize) -> GroundTruth {
+fn pixel_truth(world: &World, x: usize, y: usize) -> PixelTruth {
     let d = world.camera.direction(x as f64 + 0.5, y as f64 + 0.5);
     let o = world.camera.position;
     let hit = world.intersect(&o, &d);
@@ -312,9 +358,9 @@ fn ground_truth(world: &World, x: usize, y: usize) -> GroundTruth {
         (-crate::tracking::optical_depth(m, &o, &d, t_hit)).exp() as f32
     });
     let Some(hit) = hit else {
-        return GroundTruth {
+        return PixelTruth {
             transmission,
-            ..GroundTruth::default()
+            ..PixelTruth::default()
         };
     };
     let shape = &world.scene.shapes[hit.shape];
@@ -328,7 +374,7 @@ fn ground_truth(world: &World, x: usize, y: usize) -> GroundTruth {
         (false, Some(m)) => material_label(&world.scene.materials[m].material),
         _ => MaterialLabel::Background,
     };
-    GroundTruth {
+    PixelTruth {
         normal: [n.x as f32, n.y as f32, n.z as f32],
         depth: world.camera.depth(&hit.p) as f32,
         label,
@@ -347,46 +393,45 @@ fn material_label(m: &Material) -> MaterialLabel {
     }
 }
 
-fn assemble(
-    scene: &Scene,
-    tiles: Vec<TileResult>,
-    model: Polarization,
-    seconds: f64,
-) -> RenderOutput {
+/// The Stokes image of `tiles`, and their ground truth if `pass` computed it.
+fn assemble(scene: &Scene, tiles: Vec<TileResult>, pass: Pass) -> (StokesImage, Option<FirstHit>) {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut stokes = StokesImage::new(w, h);
-    let mut normal = Image::<f32, 3>::new(w, h);
-    let mut depth = Gray::<f32>::new(w, h);
-    let mut material = Gray::<u8>::new(w, h);
-    let mut transparent = Gray::<u8>::new(w, h);
-    let mut transmission = Gray::<f32>::new(w, h);
+    let mut truth = pass.ground_truth.then(|| FirstHit {
+        normal: Image::new(w, h),
+        depth: Gray::new(w, h),
+        material: Gray::new(w, h),
+        transparent: Gray::new(w, h),
+        transmission: scene.medium.is_some().then(|| Gray::new(w, h)),
+    });
     for t in tiles {
-        for (i, (s, g)) in t.stokes.iter().zip(&t.gt).enumerate() {
-            let p = (t.y0 + i / t.w) * w + t.x0 + i % t.w;
-            stokes.pixels_mut()[p] = *s;
-            normal.pixels_mut()[p] = g.normal;
-            depth.pixels_mut()[p] = [g.depth];
-            material.pixels_mut()[p] = [g.label.value()];
-            transparent.pixels_mut()[p] = [if g.label == MaterialLabel::Transparent {
-                TRANSPARENT_MASK_ON
-            } else {
-                0
-            }];
-            transmission.pixels_mut()[p] = [g.transmission];
+        let index = |i: usize| (t.y0 + i / t.w) * w + t.x0 + i % t.w;
+        for (i, s) in t.stokes.iter().enumerate() {
+            stokes.pixels_mut()[index(i)] = *s;
+        }
+        if let Some(truth) = truth.as_mut() {
+            for (i, g) in t.gt.iter().enumerate() {
+                truth.set(index(i), g);
+            }
         }
     }
-    RenderOutput {
-        stokes,
-        normal,
-        depth,
-        material,
-        transparent,
-        clear: None,
-        dehazed: None,
-        transmission: scene.medium.is_some().then_some(transmission),
-        model,
-        seconds,
-        spp: scene.settings.spp,
+    (stokes, truth)
+}
+
+impl FirstHit {
+    /// Stores the truth `g` of pixel index `p`.
+    fn set(&mut self, p: usize, g: &PixelTruth) {
+        self.normal.pixels_mut()[p] = g.normal;
+        self.depth.pixels_mut()[p] = [g.depth];
+        self.material.pixels_mut()[p] = [g.label.value()];
+        self.transparent.pixels_mut()[p] = [if g.label == MaterialLabel::Transparent {
+            TRANSPARENT_MASK_ON
+        } else {
+            0
+        }];
+        if let Some(t) = self.transmission.as_mut() {
+            t.pixels_mut()[p] = [g.transmission];
+        }
     }
 }
 
@@ -400,9 +445,9 @@ mod tests {
     /// The bits of the Stokes image of `scene` rendered on the SIMD target `arch`.
     fn stokes_bits(scene: &Scene, arch: Arch) -> Vec<u32> {
         let model = required_model(scene);
-        let tiles = render_on(scene, model, false, arch, &|_, _| {});
-        let out = assemble(scene, tiles, model, 0.0);
-        out.stokes.as_slice().iter().map(|v| v.to_bits()).collect()
+        let tiles = render_on(scene, model, Pass::default(), arch, &|_, _| {});
+        let (stokes, _) = assemble(scene, tiles, Pass::default());
+        stokes.as_slice().iter().map(|v| v.to_bits()).collect()
     }
 
     /// Every SIMD target this CPU has (AVX2+FMA, AVX-512) renders the five

@@ -14,6 +14,7 @@ use crate::shapes::{TriangleMesh, check_mesh};
 use polar_bsdf::Material;
 use polar_optics::OpticsError;
 use polar_optics::sky::RayleighSky;
+use polar_sensor::SensorSettings;
 use std::path::Path;
 
 /// Largest image side in pixels a scene may ask for (the area is further bounded by
@@ -167,8 +168,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The participating medium, if any (at most one).
     pub medium: Option<Medium>,
-    /// Sensor parameters, kept verbatim for the sensor model (polar-sensor).
-    pub sensor: Option<toml::Table>,
+    /// Sensor noise settings (not used by the renderer; for the sensor model that
+    /// turns its Stokes image into a raw frame).
+    pub sensor: SensorSettings,
 }
 
 impl Scene {
@@ -181,7 +183,7 @@ impl Scene {
             shapes: Vec::new(),
             lights: Vec::new(),
             medium: None,
-            sensor: None,
+            sensor: SensorSettings::default(),
         }
     }
 

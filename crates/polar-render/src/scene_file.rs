@@ -12,6 +12,7 @@ use crate::shapes;
 use num_complex::Complex64;
 use polar_optics::scatter::PhaseFunction;
 use polar_optics::sky::RayleighSky;
+use polar_sensor::SensorSettings;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -35,7 +36,8 @@ struct SceneFile {
     #[serde(default)]
     lights: Vec<LightDesc>,
     medium: Option<MediumDesc>,
-    sensor: Option<toml::Table>,
+    #[serde(default)]
+    sensor: SensorSettings,
 }
 
 #[derive(Deserialize)]
@@ -272,6 +274,9 @@ fn build(desc: SceneFile, file: &Path, base: &Path) -> Result<Scene, Error> {
         split_depth: desc.render.split_depth,
         sampler: desc.render.sampler,
     };
+    desc.sensor
+        .check()
+        .map_err(|reason| invalid(file, "sensor", reason))?;
     scene.sensor = desc.sensor;
     let names: Vec<String> = desc.materials.keys().cloned().collect();
     for (name, m) in desc.materials {

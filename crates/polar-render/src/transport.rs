@@ -8,7 +8,7 @@
 //! - [`Full`] (4×4): the complete Mueller calculus.
 
 use nalgebra::{Matrix3, Vector3};
-use polar_bsdf::Polarization;
+use polar_optics::Polarization;
 use polar_optics::frame::rotate_rows;
 use polar_optics::{Mueller, Stokes};
 
@@ -163,15 +163,6 @@ impl Transport for Full {
     }
     fn first_row(&self) -> Stokes {
         self.0.row(0).transpose()
-    }
-}
-
-/// The polarization an emitter needs: `Linear` if `S1` or `S2` is non-zero, `Full` if `S3` is.
-pub fn emission_polarization(polarization: &[f64; 3]) -> Polarization {
-    match polarization {
-        [_, _, s3] if *s3 != 0.0 => Polarization::Full,
-        [s1, s2, _] if *s1 != 0.0 || *s2 != 0.0 => Polarization::Linear,
-        _ => Polarization::None,
     }
 }
 

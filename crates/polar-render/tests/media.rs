@@ -12,7 +12,7 @@ use polar_render::{
 use std::f64::consts::PI;
 
 mod common;
-use common::{V3, bits, camera, run, run_dehazed, run_on_threads};
+use common::{V3, bits, camera, run, run_dehazed, run_on_threads, truth};
 
 /// The medium filling `[-1, 1]³`.
 fn unit_box(sigma_s: f64, sigma_a: f64, phase: PhaseFunction) -> Medium {
@@ -67,7 +67,7 @@ fn beer_lambert_transmittance_of_a_homogeneous_box() {
         .push(Light::Environment(Emission::unpolarized(1.0)));
     let out = run(&scene, None);
     assert_eq!(out.model, Polarization::None, "nothing scatters");
-    let tr = out.transmission.as_ref().expect("transmission");
+    let tr = truth(&out).transmission.as_ref().expect("transmission");
     for y in 0..8 {
         for x in 0..8 {
             let expected = (-0.5 * central_length(&cam, x, y)).exp();
@@ -100,7 +100,7 @@ fn beer_lambert_by_ratio_tracking_on_a_grid() {
     let (m, _) = mean(out.stokes.pixels().iter().map(|p| f64::from(p[0])));
     let expected = (-1.0_f64).exp();
     assert!((m - expected).abs() < 0.015, "mean S0 {m} vs {expected}");
-    let tr = out.transmission.as_ref().expect("transmission");
+    let tr = truth(&out).transmission.as_ref().expect("transmission");
     assert!(
         (f64::from(tr.pixel(8, 8)[0]) - (-0.5 * central_length(&cam, 8, 8)).exp()).abs() < 1e-6
     );
@@ -111,7 +111,7 @@ fn beer_lambert_by_ratio_tracking_on_a_grid() {
     };
     scene.medium.as_mut().expect("medium").density = Some(ramp);
     let out = run(&scene, None);
-    let tr = out.transmission.as_ref().expect("transmission");
+    let tr = truth(&out).transmission.as_ref().expect("transmission");
     // Exact: the clamped trilinear ramp over z ∈ [−1, 1] integrates to 1.2 (0.2 · 0.2 + 0.8 ·
     // 1.2 + 1 · 0.2), times the 1/cos stretch of the oblique ray.
     let (got, n) = mean(out.stokes.pixels().iter().map(|p| f64::from(p[0])));
@@ -322,8 +322,8 @@ fn constant_grid_matches_homogeneous_medium() {
             "channel {c}: mean diff {m}, se {se}"
         );
     }
-    let ta = a.transmission.expect("transmission");
-    let tb = b.transmission.expect("transmission");
+    let ta = truth(&a).transmission.as_ref().expect("transmission");
+    let tb = truth(&b).transmission.as_ref().expect("transmission");
     for (p, q) in ta.pixels().iter().zip(tb.pixels()) {
         assert!((p[0] - q[0]).abs() < 1e-6);
     }
@@ -357,17 +357,17 @@ fn linear_transport_matches_full_in_a_rayleigh_medium() {
 fn hazy_render_is_bit_identical_across_thread_counts_and_has_ground_truth() {
     let s = hazy_sphere(Some(constant_grid(0.7)));
     let one = run_on_threads(&s, 1);
-    assert!(one.clear.is_some());
+    assert!(one.clear.is_some() && truth(&one).transmission.is_some());
     assert_eq!(bits(&one), bits(&run_on_threads(&s, 2)));
-    // The clear view is an option: without it, the same image and no clear render.
+    // The clear view and the ground truth are options: without them, the same image.
     let lean = render(&s, &RenderOptions::default(), &|_, _| {}).expect("render");
-    assert!(lean.clear.is_none() && lean.transmission.is_some());
+    assert!(lean.clear.is_none() && lean.ground_truth.is_none());
     assert_eq!(bits(&lean), bits(&one)[..bits(&lean).len()]);
     // The clear image is the medium-free render of the same view.
     let mut no_medium = s.clone();
     no_medium.medium = None;
     let plain = run(&no_medium, None);
-    assert!(plain.clear.is_none() && plain.transmission.is_none());
+    assert!(plain.clear.is_none() && truth(&plain).transmission.is_none());
     assert_eq!(
         plain.stokes.channel(0).as_slice(),
         one.clear.as_ref().expect("clear").as_slice()
@@ -535,7 +535,7 @@ fn camera_inside_the_medium_sees_an_attenuated_lamp() {
     });
     let out = run(&scene, None);
     let expected = (-0.4_f64 * 1.5).exp();
-    let tr = out.transmission.as_ref().expect("transmission");
+    let tr = truth(&out).transmission.as_ref().expect("transmission");
     assert!((f64::from(tr.pixel(4, 4)[0]) - expected).abs() < 1e-4);
     for (s, t) in out.stokes.pixels().iter().zip(tr.pixels()) {
         assert!(
@@ -657,10 +657,10 @@ fn dehazed_plane_in_a_haze_slab_obeys_koschmieder() {
     let (dehazed, clear, t) = (
         out.dehazed.as_ref().expect("dehazed"),
         out.clear.as_ref().expect("clear"),
-        out.transmission.as_ref().expect("transmission"),
+        truth(&out).transmission.as_ref().expect("transmission"),
     );
     let s0 = |img: &polar_image::Gray<f32>, x, y| f64::from(img.pixel(x, y)[0]);
-    let depth = |x, y| s0(&out.depth, x, y);
+    let depth = |x, y| s0(&truth(&out).depth, x, y);
     assert!(
         region_mean(PLANE_COLS, |x, y| depth(x, y).min(1.0)) == 1.0,
         "plane"

@@ -8,7 +8,7 @@ use polar_render::{
 };
 
 mod common;
-use common::{V3, bits, run, run_on_threads};
+use common::{V3, bits, run, run_on_threads, truth};
 
 fn lambertian(albedo: f64) -> Material {
     Material::Lambertian(LambertianParams {
@@ -197,27 +197,28 @@ fn ground_truth_buffers_follow_the_conventions() {
     s.camera.height = 33;
     s.settings.spp = 1;
     let out = run(&s, None);
+    let gt = truth(&out);
     // Centre pixel: the sphere's front point (0, 0, 1), facing the camera, 4 units along -z.
-    let n = out.normal.pixel(16, 16);
+    let n = gt.normal.pixel(16, 16);
     assert!(
         (n[0].abs() + n[1].abs()) < 1e-6 && (n[2] - 1.0).abs() < 1e-6,
         "{n:?}"
     );
-    assert!((out.depth.pixel(16, 16)[0] - 4.0).abs() < 1e-5);
-    assert_eq!(out.material.pixel(16, 16)[0], 3);
-    assert_eq!(out.transparent.pixel(16, 16)[0], 255);
+    assert!((gt.depth.pixel(16, 16)[0] - 4.0).abs() < 1e-5);
+    assert_eq!(gt.material.pixel(16, 16)[0], 3);
+    assert_eq!(gt.transparent.pixel(16, 16)[0], 255);
     // Top corner: sky (no surface).
-    assert_eq!(out.normal.pixel(0, 0), &[0.0; 3]);
-    assert_eq!(out.depth.pixel(0, 0)[0], 0.0);
-    assert_eq!(out.material.pixel(0, 0)[0], 0);
+    assert_eq!(gt.normal.pixel(0, 0), &[0.0; 3]);
+    assert_eq!(gt.depth.pixel(0, 0)[0], 0.0);
+    assert_eq!(gt.material.pixel(0, 0)[0], 0);
     // Bottom row: the floor has normal and depth but is background (label 0).
-    let floor = out.normal.pixel(16, 32);
+    let floor = gt.normal.pixel(16, 32);
     assert!(floor[1] > 0.9, "{floor:?}");
-    assert!(out.depth.pixel(16, 32)[0] > 0.0);
-    assert_eq!(out.material.pixel(16, 32)[0], 0);
+    assert!(gt.depth.pixel(16, 32)[0] > 0.0);
+    assert_eq!(gt.material.pixel(16, 32)[0], 0);
     // Normals on the sphere point right on the right side and up at the top (camera frame).
-    assert!(out.normal.pixel(24, 16)[0] > 0.5 && out.normal.pixel(16, 8)[1] > 0.5);
-    for p in out.normal.pixels() {
+    assert!(gt.normal.pixel(24, 16)[0] > 0.5 && gt.normal.pixel(16, 8)[1] > 0.5);
+    for p in gt.normal.pixels() {
         let len = p.iter().map(|c| c * c).sum::<f32>().sqrt();
         assert!(len == 0.0 || (len - 1.0).abs() < 1e-5);
     }

@@ -5,7 +5,9 @@
 //! - inverse: [`demosaic()`] turns a raw mosaic into the four polarizer images
 //!   with a selectable [`DemosaicMethod`], and [`products`] fuses demosaicing
 //!   with Stokes, DoLP and AoLP for speed; [`mask`] flags pixels that cannot be
-//!   trusted and [`picture`] renders 8-bit pictures.
+//!   trusted and [`picture`] renders 8-bit pictures;
+//! - [`settings`]: the noise settings a user writes (a scene's `[sensor]` table) and
+//!   their bounds.
 //!
 //! The mosaic layout is the Sony IMX250MZR one (see [`layout`]): super-pixel
 //! row 0 = `[90°, 45°]`, row 1 = `[135°, 0°]`. The physics (Malus's law, Stokes
@@ -19,12 +21,14 @@ pub mod observation;
 pub mod picture;
 pub mod products;
 pub mod sensor;
+pub mod settings;
 
 pub use demosaic::{DemosaicMethod, demosaic};
 pub use layout::{Mosaic, MosaicSample};
 pub use observation::Observation;
 pub use products::{StokesPlanes, stokes_planes, stokes_planes_from_angles};
 pub use sensor::{SensorModel, SensorOutput};
+pub use settings::SensorSettings;
 
 use thiserror::Error;
 

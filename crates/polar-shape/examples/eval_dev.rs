@@ -52,11 +52,14 @@ fn args() -> Args {
 fn observation(dir: &Path, fov: f64, exr: bool) -> Observation {
     let camera = CameraModel::Pinhole { fov_x_deg: fov };
     if exr {
-        let img =
-            polar_io::read_exr(dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS).unwrap();
+        let img = polar_io::read_exr(
+            dir.join(polar_io::files::STOKES),
+            polar_io::LINEAR_STOKES_CHANNELS,
+        )
+        .unwrap();
         Observation::new(StokesPlanes::from_linear_stokes(&img), camera)
     } else {
-        let png = polar_io::read_mosaic(dir.join("raw.png")).unwrap();
+        let png = polar_io::read_mosaic(dir.join(polar_io::files::RAW)).unwrap();
         let m = DemosaicMethod::Residual;
         let planes = stokes_planes(&png.image, m).unwrap();
         let flags = validity_mask(
@@ -293,7 +296,11 @@ fn split_error(est: &Image<f32, 3>, gt: &Image<f32, 3>, mask: &Gray<u8>, fov: f6
 
 /// Times both methods on a sample upscaled (nearest neighbour) to 1024² and 512².
 fn speed(dir: &Path) {
-    let img = polar_io::read_exr(dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS).unwrap();
+    let img = polar_io::read_exr(
+        dir.join(polar_io::files::STOKES),
+        polar_io::LINEAR_STOKES_CHANNELS,
+    )
+    .unwrap();
     for size in [512usize, 1024] {
         let (w, h) = img.size();
         let data = (0..size * size)

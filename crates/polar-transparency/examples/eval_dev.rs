@@ -39,11 +39,14 @@ fn load(dir: &Path, from_stokes: bool) -> Case {
         .to_owned();
     let camera = CameraModel::Pinhole { fov_x_deg: fov };
     let obs = if from_stokes {
-        let st = polar_io::read_exr(dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS)
-            .expect("stokes.exr");
+        let st = polar_io::read_exr(
+            dir.join(polar_io::files::STOKES),
+            polar_io::LINEAR_STOKES_CHANNELS,
+        )
+        .expect(polar_io::files::STOKES);
         Observation::new(StokesPlanes::from_linear_stokes(&st), camera)
     } else {
-        let raw = s.raw.expect("raw.png").image;
+        let raw = s.raw.expect(polar_io::files::RAW).image;
         let bits = meta["sensor"]["bit_depth"].as_u64().unwrap_or(16) as u32;
         let planes = stokes_planes(&raw, DemosaicMethod::Residual).expect("demosaic");
         let flags = validity_mask(&raw, (1 << bits) - 1, DemosaicMethod::Residual, &planes.s0);
@@ -122,7 +125,11 @@ fn main() {
         glass.len(),
         opaque.len(),
         root.display(),
-        if from_stokes { "stokes.exr" } else { "raw.png" }
+        if from_stokes {
+            polar_io::files::STOKES
+        } else {
+            polar_io::files::RAW
+        }
     );
     let mut noises: Vec<String> = glass
         .iter()
@@ -134,7 +141,11 @@ fn main() {
     for noise in &noises {
         let mut g = Glass::default();
         for c in glass.iter().filter(|c| &c.noise == noise) {
-            let truth = binary(c.transparent.as_ref().expect("gt/transparent.png"));
+            let truth = binary(
+                c.transparent
+                    .as_ref()
+                    .expect(polar_io::files::GT_TRANSPARENT),
+            );
             let t = Instant::now();
             let out = detect(&c.obs, &opts).expect("detect");
             g.secs += t.elapsed().as_secs_f64();
@@ -160,7 +171,7 @@ fn main() {
         }
         let mut o = Opaque::default();
         for c in opaque.iter().filter(|c| &c.noise == noise) {
-            let mat = c.material.as_ref().expect("gt/material.png");
+            let mat = c.material.as_ref().expect(polar_io::files::GT_MATERIAL);
             let out = detect(&c.obs, &opts).expect("detect");
             o.n += 1;
             for (&p, &l) in out.mask.as_slice().iter().zip(mat.as_slice()) {

@@ -18,7 +18,7 @@ use crate::out_dir::prepare_resumable;
 use crate::run::{RunArgs, SampleReport, run_sample};
 
 /// Per-sample record kept under `OUT/samples/<name>/`, what makes a run resumable.
-const RECORD: &str = "eval.json";
+const RECORD: &str = polar_io::files::vision::EVAL_RECORD;
 
 /// Arguments of `polar-vision eval`.
 #[derive(Debug, Args)]

@@ -127,7 +127,7 @@ pub fn write_outputs(
     if want(Output::Pictures) {
         let size = planes.s0.size();
         jobs.push(Box::new(move || {
-            polar_io::write_rgb8_png_rows(out.join("aolp.png"), size, |y, bytes| {
+            polar_io::write_rgb8_png_rows(out.join(vision::AOLP_PICTURE), size, |y, bytes| {
                 let (px, k) = pixel_rows(size.0, y, bytes);
                 aolp_hsv_into(
                     &planes.aolp.as_slice()[k.clone()],
@@ -137,7 +137,7 @@ pub fn write_outputs(
             })
         }));
         jobs.push(Box::new(move || {
-            polar_io::write_rgb8_png_rows(out.join("dolp.png"), size, |y, bytes| {
+            polar_io::write_rgb8_png_rows(out.join(vision::DOLP_PICTURE), size, |y, bytes| {
                 let (px, k) = pixel_rows(size.0, y, bytes);
                 colormap_into(&planes.dolp.as_slice()[k], 0.0, 1.0, px);
             })
@@ -145,7 +145,7 @@ pub fn write_outputs(
         jobs.push(Box::new(move || {
             let s0 = planes.s0.as_slice();
             let s0_max = quantile(s0.iter().copied(), 0.995).unwrap_or(1.0);
-            polar_io::write_rgb8_png_rows(out.join("s0.png"), size, |y, bytes| {
+            polar_io::write_rgb8_png_rows(out.join(vision::S0_PICTURE), size, |y, bytes| {
                 let (px, k) = pixel_rows(size.0, y, bytes);
                 colormap_into(&s0[k], 0.0, s0_max, px);
             })
@@ -153,7 +153,7 @@ pub fn write_outputs(
     }
     if let Some(mask) = mask.filter(|_| want(Output::Mask)) {
         jobs.push(Box::new(move || {
-            polar_io::write_gray8_png(out.join("mask.png"), mask)
+            polar_io::write_gray8_png(out.join(vision::MASK), mask)
         }));
     }
     jobs.into_par_iter()

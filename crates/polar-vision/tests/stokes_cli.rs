@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use polar_image::Gray;
+use polar_io::files::{self, vision};
 use polar_sensor::{DemosaicMethod, stokes_planes};
 
 fn run(args: &[&str]) -> Output {
@@ -44,20 +45,20 @@ fn p(path: &Path) -> &str {
 }
 
 const OUTPUTS: [&str; 7] = [
-    "stokes.exr",
-    "dolp.exr",
-    "aolp.exr",
-    "aolp.png",
-    "dolp.png",
-    "s0.png",
-    "mask.png",
+    vision::STOKES,
+    vision::DOLP,
+    vision::AOLP,
+    vision::AOLP_PICTURE,
+    vision::DOLP_PICTURE,
+    vision::S0_PICTURE,
+    vision::MASK,
 ];
 
 #[test]
 fn writes_every_output_and_matches_the_library() {
     let dir = tempfile::tempdir().unwrap();
     let raw = mosaic8(16, 12);
-    let input = dir.path().join("raw.png");
+    let input = dir.path().join(files::RAW);
     polar_io::write_gray8_png(&input, &raw).unwrap();
     let out_dir = dir.path().join("out");
     for method in DemosaicMethod::ALL {
@@ -74,10 +75,13 @@ fn writes_every_output_and_matches_the_library() {
             assert!(out_dir.join(f).is_file(), "{method}: missing {f}");
         }
         let want = stokes_planes(&raw, method).unwrap();
-        let got = polar_io::read_exr(out_dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS)
-            .unwrap();
+        let got = polar_io::read_exr(
+            out_dir.join(vision::STOKES),
+            polar_io::LINEAR_STOKES_CHANNELS,
+        )
+        .unwrap();
         assert_eq!(got, want.linear_stokes(), "{method}");
-        let dolp = polar_io::read_exr_channel(out_dir.join("dolp.exr"), "Y").unwrap();
+        let dolp = polar_io::read_exr_channel(out_dir.join(vision::DOLP), "Y").unwrap();
         assert_eq!(dolp.size(), want.dolp.size());
     }
 }
@@ -87,7 +91,7 @@ fn sample_directory_with_raw_png_or_only_stokes_exr() {
     let dir = tempfile::tempdir().unwrap();
     let sample = dir.path().join("sample");
     std::fs::create_dir(&sample).unwrap();
-    polar_io::write_gray8_png(sample.join("raw.png"), &mosaic8(8, 8)).unwrap();
+    polar_io::write_gray8_png(sample.join(files::RAW), &mosaic8(8, 8)).unwrap();
     let out1 = dir.path().join("o1");
     let first = run(&["stokes", p(&sample), "--out", p(&out1)]);
     assert!(first.status.success(), "{}", stderr(&first));
@@ -98,8 +102,8 @@ fn sample_directory_with_raw_png_or_only_stokes_exr() {
     );
 
     // Only stokes.exr: DoLP/AoLP from it directly.
-    std::fs::remove_file(sample.join("raw.png")).unwrap();
-    std::fs::copy(out1.join("stokes.exr"), sample.join("stokes.exr")).unwrap();
+    std::fs::remove_file(sample.join(files::RAW)).unwrap();
+    std::fs::copy(out1.join(vision::STOKES), sample.join(files::STOKES)).unwrap();
     let out2 = dir.path().join("o2");
     let out = run(&["stokes", p(&sample), "--out", p(&out2)]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -110,11 +114,11 @@ fn sample_directory_with_raw_png_or_only_stokes_exr() {
         "{status}"
     );
     assert_eq!(
-        polar_io::read_exr_channel(out1.join("dolp.exr"), "Y").unwrap(),
-        polar_io::read_exr_channel(out2.join("dolp.exr"), "Y").unwrap()
+        polar_io::read_exr_channel(out1.join(vision::DOLP), "Y").unwrap(),
+        polar_io::read_exr_channel(out2.join(vision::DOLP), "Y").unwrap()
     );
 
-    std::fs::remove_file(sample.join("stokes.exr")).unwrap();
+    std::fs::remove_file(sample.join(files::STOKES)).unwrap();
     fails_with(
         &["stokes", p(&sample), "--out", p(&out2)],
         "not a PNG file nor a sample directory",
@@ -149,7 +153,7 @@ fn odd_tiny_zero_and_saturated_frames_are_rejected() {
     let res = run(&["stokes", p(&part), "--out", p(&out)]);
     assert!(res.status.success());
     assert!(stderr(&res).contains("1 of 64 pixels"), "{}", stderr(&res));
-    let mask = polar_io::read_gray8_png(out.join("mask.png")).unwrap();
+    let mask = polar_io::read_gray8_png(out.join(vision::MASK)).unwrap();
     assert_eq!(mask.pixel(0, 0)[0], polar_sensor::mask::SATURATED);
     assert_eq!(mask.pixel(7, 7)[0], 0);
 }
@@ -190,7 +194,7 @@ fn twelve_bit_data_left_or_right_aligned_in_16_bit_png() {
         "left",
     ]);
     assert!(ok.status.success(), "{}", stderr(&ok));
-    let s = |o: &Path| polar_io::read_exr_channel(o.join("stokes.exr"), "S0").unwrap();
+    let s = |o: &Path| polar_io::read_exr_channel(o.join(vision::STOKES), "S0").unwrap();
     assert_eq!(s(&o1), s(&o2), "both alignments give the same DN");
 
     fails_with(
@@ -268,19 +272,19 @@ fn truncated_non_png_missing_input_and_bad_arguments() {
 #[test]
 fn out_folder_is_replaced_as_a_whole_and_a_user_folder_is_kept() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("raw.png");
+    let input = dir.path().join(files::RAW);
     polar_io::write_gray8_png(&input, &mosaic8(16, 12)).unwrap();
     let out = dir.path().join("o");
     let first = run(&["stokes", p(&input), "--out", p(&out)]);
     assert!(first.status.success(), "{}", stderr(&first));
-    assert!(out.join("mask.png").is_file());
+    assert!(out.join(vision::MASK).is_file());
     let again = run(&["stokes", p(&input), "--out", p(&out), "--outputs", "dolp"]);
     assert!(again.status.success(), "{}", stderr(&again));
     assert!(
-        !out.join("mask.png").exists(),
+        !out.join(vision::MASK).exists(),
         "stale mask.png of the first run"
     );
-    assert!(out.join("dolp.exr").is_file());
+    assert!(out.join(vision::DOLP).is_file());
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name())
@@ -308,8 +312,8 @@ fn help_explains_every_option() {
         "newton",
         "--bit-depth",
         "--align",
-        "aolp.png",
-        "mask.png",
+        vision::AOLP_PICTURE,
+        vision::MASK,
     ] {
         assert!(help.contains(needle), "help lacks {needle}:\n{help}");
     }
@@ -330,7 +334,7 @@ fn help_lists_every_method_and_the_default_is_residual() {
 
     let dir = tempfile::tempdir().unwrap();
     let raw = mosaic8(12, 10);
-    let input = dir.path().join("raw.png");
+    let input = dir.path().join(files::RAW);
     polar_io::write_gray8_png(&input, &raw).unwrap();
     let out_dir = dir.path().join("out");
     assert!(
@@ -338,8 +342,11 @@ fn help_lists_every_method_and_the_default_is_residual() {
             .status
             .success()
     );
-    let got =
-        polar_io::read_exr(out_dir.join("stokes.exr"), polar_io::LINEAR_STOKES_CHANNELS).unwrap();
+    let got = polar_io::read_exr(
+        out_dir.join(vision::STOKES),
+        polar_io::LINEAR_STOKES_CHANNELS,
+    )
+    .unwrap();
     let want = stokes_planes(&raw, DemosaicMethod::Residual).unwrap();
     assert_eq!(got, want.linear_stokes());
 }
@@ -347,7 +354,7 @@ fn help_lists_every_method_and_the_default_is_residual() {
 #[test]
 fn outputs_writes_only_the_files_asked_for() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("raw.png");
+    let input = dir.path().join(files::RAW);
     polar_io::write_gray8_png(&input, &mosaic8(16, 12)).unwrap();
     let out = dir.path().join("o");
     let result = run(&[
@@ -364,7 +371,7 @@ fn outputs_writes_only_the_files_asked_for() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     written.sort();
-    assert_eq!(written, [".polar-vision", "dolp.exr", "stokes.exr"]);
+    assert_eq!(written, [vision::MARKER, vision::DOLP, vision::STOKES]);
     fails_with(
         &[
             "stokes",
@@ -384,7 +391,7 @@ fn an_output_folder_inside_the_input_sample_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let sample = dir.path().join("sample");
     std::fs::create_dir(&sample).unwrap();
-    polar_io::write_gray8_png(sample.join("raw.png"), &mosaic8(8, 8)).unwrap();
+    polar_io::write_gray8_png(sample.join(files::RAW), &mosaic8(8, 8)).unwrap();
     fails_with(
         &["stokes", p(&sample), "--out", p(&sample)],
         "would be overwritten",
@@ -392,7 +399,7 @@ fn an_output_folder_inside_the_input_sample_is_refused() {
     let inner = sample.join("out");
     fails_with(&["stokes", p(&sample), "--out", p(&inner)], "inside");
     assert!(!inner.exists(), "nothing is created before the refusal");
-    let raw = sample.join("raw.png");
+    let raw = sample.join(files::RAW);
     fails_with(
         &["stokes", p(&raw), "--out", p(&sample)],
         "would be overwritten",
@@ -410,7 +417,7 @@ fn an_output_folder_inside_the_input_sample_is_refused() {
 #[test]
 fn max_pixels_refuses_larger_images_from_the_header() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("raw.png");
+    let input = dir.path().join(files::RAW);
     polar_io::write_gray8_png(&input, &mosaic8(16, 12)).unwrap();
     let out = dir.path().join("o");
     fails_with(

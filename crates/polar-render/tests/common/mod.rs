@@ -1,7 +1,7 @@
 //! Helpers shared by the renderer's integration tests (each test file uses a subset).
 #![allow(dead_code)]
 
-use polar_render::{Camera, Polarization, RenderOptions, RenderOutput, Scene, render};
+use polar_render::{Camera, FirstHit, Polarization, RenderOptions, RenderOutput, Scene, render};
 
 /// World vectors.
 pub type V3 = nalgebra::Vector3<f64>;
@@ -18,25 +18,33 @@ pub fn camera(distance: f64, fov_deg: f64, size: usize) -> Camera {
     }
 }
 
-/// Renders silently, with the cheapest exact model or the one forced (with a medium,
-/// also the clear view).
+/// Renders silently, with the cheapest exact model or the one forced, with the ground
+/// truth (and with a medium the clear view).
 pub fn run(scene: &Scene, model: Option<Polarization>) -> RenderOutput {
     let opts = RenderOptions {
         force_model: model,
+        ground_truth: true,
         clear: true,
         ..Default::default()
     };
     render(scene, &opts, &|_, _| {}).expect("render")
 }
 
-/// Renders silently with the cheapest exact model, with the clear and dehazed ground truth.
+/// Renders silently with the cheapest exact model, with the ground truth, the clear and
+/// the dehazed view.
 pub fn run_dehazed(scene: &Scene) -> RenderOutput {
     let opts = RenderOptions {
+        ground_truth: true,
         clear: true,
         dehazed: true,
         ..Default::default()
     };
     render(scene, &opts, &|_, _| {}).expect("render")
+}
+
+/// The ground truth of a render made with it.
+pub fn truth(o: &RenderOutput) -> &FirstHit {
+    o.ground_truth.as_ref().expect("ground truth")
 }
 
 /// Renders on a pool of `threads` threads.

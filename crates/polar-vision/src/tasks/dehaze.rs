@@ -25,7 +25,11 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     polar_io::write_exr(out.join(vision::HAZE_DEPTH), &d.depth, Y_CHANNEL).map_err(io)?;
     let s0 = &ctx.obs.planes.s0;
     let picture = side_by_side(&[s0, &d.radiance], Some(&d.transmission));
-    polar_io::write_rgb8_png(picture_path(out, "dehaze.png"), &picture).map_err(io)?;
+    polar_io::write_rgb8_png(
+        picture_path(out, polar_io::files::vision::pictures::DEHAZE),
+        &picture,
+    )
+    .map_err(io)?;
     let mut outcome = Outcome {
         metrics: None,
         messages: d.warnings.clone(),

@@ -31,7 +31,11 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     )
     .map_err(io)?;
     let picture = label_picture(&map.labels, &MATERIAL_PALETTE);
-    polar_io::write_rgb8_png(picture_path(out, "material.png"), &picture).map_err(io)?;
+    polar_io::write_rgb8_png(
+        picture_path(out, polar_io::files::vision::pictures::MATERIAL),
+        &picture,
+    )
+    .map_err(io)?;
     let mut outcome = Outcome::default();
     if let Classifier::Knn(m) = &clf {
         outcome.messages.push(format!(

@@ -55,9 +55,16 @@ fn write(ctx: &Context<'_>, s: &Shape) -> Result<(), Failure> {
     )
     .map_err(io)?;
     polar_io::write_gray8_png(out.join(vision::REFLECTION), &s.reflection).map_err(io)?;
-    polar_io::write_rgb8_png(picture_path(out, "normal.png"), &normal_picture(&s.normal))
-        .map_err(io)?;
+    polar_io::write_rgb8_png(
+        picture_path(out, polar_io::files::vision::pictures::NORMAL),
+        &normal_picture(&s.normal),
+    )
+    .map_err(io)?;
     let types = label_picture(&s.reflection, &REFLECTION_PALETTE);
-    polar_io::write_rgb8_png(picture_path(out, "reflection.png"), &types).map_err(io)?;
+    polar_io::write_rgb8_png(
+        picture_path(out, polar_io::files::vision::pictures::REFLECTION),
+        &types,
+    )
+    .map_err(io)?;
     Ok(())
 }

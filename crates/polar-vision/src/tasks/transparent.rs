@@ -20,7 +20,11 @@ pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> 
     polar_io::write_gray8_png(out.join(vision::TRANSPARENT), &map.mask).map_err(io)?;
     polar_io::write_exr(out.join(vision::TRANSPARENT_SCORE), &map.score, Y_CHANNEL).map_err(io)?;
     let picture = overlay_picture(&ctx.obs.planes.s0, &map.mask);
-    polar_io::write_rgb8_png(picture_path(out, "transparent.png"), &picture).map_err(io)?;
+    polar_io::write_rgb8_png(
+        picture_path(out, polar_io::files::vision::pictures::TRANSPARENT),
+        &picture,
+    )
+    .map_err(io)?;
     let mut outcome = Outcome::default();
     if let Some(gt) = &ctx.gt.transparent {
         let opaque = ctx.gt.material.as_ref().map(opaque_objects);
