@@ -8,7 +8,7 @@ use crate::scene::{Light, Scene};
 use crate::transport::{Full, Linear, Scalar, Transport, emission_polarization};
 use crate::world::World;
 use polar_bsdf::{Material, Polarization};
-use polar_image::{Gray, Image, StokesImage};
+use polar_image::{Gray, NormalImage, StokesImage};
 use polar_io::{MaterialLabel, TRANSPARENT_MASK_ON};
 use polar_optics::Stokes;
 use pulp::{Arch, Simd, WithSimd};
@@ -39,7 +39,7 @@ pub struct RenderOutput {
     /// Stokes `S0..S3` per pixel in the conventions' camera frame.
     pub stokes: StokesImage,
     /// Camera-frame unit normal of the first hit, facing the camera; 0 where no surface.
-    pub normal: Image<f32, 3>,
+    pub normal: NormalImage,
     /// Distance along the viewing axis (camera -z) to the first hit; 0 where no surface.
     pub depth: Gray<f32>,
     /// Material labels ([`MaterialLabel`] values).
@@ -355,7 +355,7 @@ fn assemble(
 ) -> RenderOutput {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut stokes = StokesImage::new(w, h);
-    let mut normal = Image::<f32, 3>::new(w, h);
+    let mut normal = NormalImage::new(w, h);
     let mut depth = Gray::<f32>::new(w, h);
     let mut material = Gray::<u8>::new(w, h);
     let mut transparent = Gray::<u8>::new(w, h);
