@@ -35,28 +35,21 @@ impl<'a, T, const C: usize> ImageView<'a, T, C> {
         height: usize,
         stride: usize,
     ) -> Result<Self, ImageError> {
-        let needed = match height {
-            0 => Some(0),
-            _ => (height - 1)
-                .checked_mul(stride)
-                .and_then(|n| n.checked_add(width))
-                .and_then(|n| n.checked_mul(C)),
-        };
-        if stride < width || needed.is_none_or(|n| n > data.len()) {
-            return Err(ImageError::ViewBounds {
+        match span::<C>(width, height, stride) {
+            Some(n) if stride >= width && n <= data.len() => Ok(Self {
+                data: &data[..n],
+                width,
+                height,
+                stride,
+            }),
+            _ => Err(ImageError::ViewBounds {
                 len: data.len(),
                 width,
                 height,
                 stride,
                 channels: C,
-            });
+            }),
         }
-        Ok(Self {
-            data,
-            width,
-            height,
-            stride,
-        })
     }
 
     /// Width in pixels.
@@ -102,7 +95,20 @@ impl<'a, T, const C: usize> ImageView<'a, T, C> {
     /// If `(x, y)` is outside the view.
     #[inline]
     pub fn pixel(&self, x: usize, y: usize) -> &'a [T; C] {
-        &self.row(y).as_chunks::<C>().0[x]
+        self.check_column(x);
+        &self.data.as_chunks::<C>().0[y * self.stride + x]
+    }
+
+    /// Panics unless column `x` lies inside the view, where a position beyond the right edge
+    /// may still be inside the buffer (the next row's or a crop's neighbour's). Rows need no
+    /// check here: the buffer ends with the last row (see [`span`]), so a row below the
+    /// view fails the slice's own bounds check.
+    #[inline(always)]
+    #[track_caller]
+    fn check_column(&self, x: usize) {
+        if x >= self.width {
+            outside_column(x, self.width);
+        }
     }
 
     /// The `width × height` rectangle whose top-left pixel is `(x, y)`, sharing this
@@ -135,8 +141,9 @@ impl<'a, T, const C: usize> ImageView<'a, T, C> {
             });
         }
         let start = (y * self.stride + x) * C;
+        let n = span::<C>(width, height, self.stride).expect("inside a view that fits");
         Ok(Self {
-            data: &self.data[start..],
+            data: &self.data[start..start + n],
             width,
             height,
             stride: self.stride,
@@ -151,7 +158,8 @@ impl<T: Copy> ImageView<'_, T, 1> {
     /// If `(x, y)` is outside the view.
     #[inline]
     pub fn at(&self, x: usize, y: usize) -> T {
-        self.row(y)[x]
+        self.check_column(x);
+        self.data[y * self.stride + x]
     }
 }
 
@@ -164,4 +172,24 @@ impl<T: Clone, const C: usize> ImageView<'_, T, C> {
         }
         Image::from_vec(self.width, self.height, data).expect("rows of the view fill the image")
     }
+}
+
+/// Samples from the first pixel of a view to the end of its last row, `None` on overflow.
+fn span<const C: usize>(width: usize, height: usize, stride: usize) -> Option<usize> {
+    match height {
+        0 => Some(0),
+        _ => (height - 1)
+            .checked_mul(stride)
+            .and_then(|n| n.checked_add(width))
+            .and_then(|n| n.checked_mul(C)),
+    }
+}
+
+/// The panic of an access right of a view, out of line so that the check stays small
+/// enough to inline into per-pixel loops.
+#[cold]
+#[inline(never)]
+#[track_caller]
+fn outside_column(x: usize, width: usize) -> ! {
+    panic!("column {x} outside a view {width} wide")
 }

@@ -182,3 +182,19 @@ fn a_row_below_a_crop_is_not_read_from_the_image_under_it() {
     let crop = img.view().crop(0, 0, 4, 2).unwrap();
     let _ = crop.row(2);
 }
+
+#[test]
+#[should_panic(expected = "column 2 outside a view 2 wide")]
+fn a_pixel_right_of_a_crop_is_not_read_from_the_image_under_it() {
+    let img: Gray<u8> = Gray::new(4, 4);
+    let crop = img.view().crop(0, 0, 2, 2).unwrap();
+    let _ = crop.at(2, 0);
+}
+
+#[test]
+#[should_panic(expected = "index out of bounds")]
+fn a_pixel_below_a_crop_is_not_read_from_the_image_under_it() {
+    let img: Gray<u8> = Gray::new(4, 4);
+    let crop = img.view().crop(1, 1, 2, 2).unwrap();
+    let _ = crop.at(0, 2);
+}
