@@ -63,10 +63,9 @@ pub const EXR_STOKES: Target = Target {
     name: "exr_stokes",
     run: |data| {
         let path = Path::new(files::STOKES);
-        named(
-            polar_io::read_exr_from(path, Cursor::new(data), STOKES_CHANNELS),
-            path,
-        );
+        let stokes: polar_io::Result<polar_image::StokesImage> =
+            polar_io::read_exr_from(path, Cursor::new(data), STOKES_CHANNELS);
+        named(stokes, path);
     },
     bound: |_| 2 * 4 * polar_io::MAX_EXR_SAMPLES + SLACK,
 };

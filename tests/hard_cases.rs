@@ -9,7 +9,7 @@ mod common;
 use std::path::Path;
 
 use common::{arg, vision};
-use polar_image::{Gray, Image};
+use polar_image::{Mosaic, NormalImage, StokesImage};
 use polar_io::files;
 use polar_io::files::vision as out_files;
 
@@ -22,14 +22,14 @@ fn stokes_sample(dir: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f3
             [s0, s1, s2, 0.0]
         })
         .collect();
-    let img = Image::<f32, 4>::from_vec(w, h, data).unwrap();
+    let img = StokesImage::from_vec(w, h, data).unwrap();
     polar_io::write_exr(dir.join(files::STOKES), &img, polar_io::STOKES_CHANNELS).unwrap();
 }
 
 /// A sample directory holding only a 16-bit `raw.png`.
 fn raw_sample(dir: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> u16) {
     std::fs::create_dir_all(dir).unwrap();
-    let raw = Gray::from_vec(w, h, (0..w * h).map(|k| f(k % w, k / w)).collect()).unwrap();
+    let raw = Mosaic::from_vec(w, h, (0..w * h).map(|k| f(k % w, k / w)).collect()).unwrap();
     polar_io::write_gray16_png(dir.join(files::RAW), &raw).unwrap();
 }
 
@@ -57,7 +57,9 @@ fn run_all(sample: &Path) -> tempfile::TempDir {
 
 fn check_outputs(out: &Path) {
     let read = |name: &str, ch: &str| polar_io::read_exr_channel(out.join(name), ch).ok();
-    if let Ok(fg) = polar_io::read_exr(out.join(out_files::NORMAL), polar_io::RGB_CHANNELS) {
+    let normals: polar_io::Result<NormalImage> =
+        polar_io::read_exr(out.join(out_files::NORMAL), polar_io::RGB_CHANNELS);
+    if let Ok(fg) = normals {
         for n in fg.pixels() {
             let len = n.iter().map(|v| v * v).sum::<f32>().sqrt();
             assert!(len == 0.0 || (len - 1.0).abs() < 1e-3, "normal {n:?}");
@@ -173,7 +175,8 @@ fn an_almost_dark_stokes_frame_gives_documented_empty_results() {
         [if (x, y) == (3, 3) { 1e-6 } else { 0.0 }, 0.0, 0.0]
     });
     let out = run_all(&s);
-    let normals = polar_io::read_exr(out.path().join(out_files::NORMAL), polar_io::RGB_CHANNELS);
+    let normals: polar_io::Result<NormalImage> =
+        polar_io::read_exr(out.path().join(out_files::NORMAL), polar_io::RGB_CHANNELS);
     let lit = normals
         .unwrap()
         .pixels()

@@ -368,8 +368,9 @@ fn polarizer_images_decode_to_the_rendered_stokes() {
     let t = tempfile::tempdir().unwrap();
     let demo = t.path().join("demo");
     run_ok(&["demo", "--out", s(&demo), "--size", "32", "--spp", "4"]);
-    let stokes = polar_io::read_exr(demo.join(files::STOKES), polar_io::STOKES_CHANNELS).unwrap();
-    let quad =
+    let stokes: polar_image::StokesImage =
+        polar_io::read_exr(demo.join(files::STOKES), polar_io::STOKES_CHANNELS).unwrap();
+    let quad: polar_image::PolarizerStack =
         polar_io::read_exr(demo.join(files::POLARIZERS), polar_io::POLARIZER_CHANNELS).unwrap();
     let mut s0_ratio: Option<f32> = None;
     let mut checked = 0;

@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use polar_imgproc::{AngularErrorStats, ConfusionMatrix, angular_error, psnr, ssim};
 use serde::{Deserialize, Serialize};
 
@@ -51,8 +51,8 @@ impl NormalMetrics {
 /// Normal accuracy over `objects` (non-zero = scored); with `types` (a per-pixel class and
 /// its names, index = value) also per class, and with depths the fitted depth error.
 pub fn normal_metrics(
-    est: &Image<f32, 3>,
-    truth: &Image<f32, 3>,
+    est: &NormalImage,
+    truth: &NormalImage,
     objects: &Gray<u8>,
     types: Option<(&Gray<u8>, &[&str])>,
     depth: Option<(&Gray<f32>, &Gray<f32>)>,
@@ -308,8 +308,8 @@ mod tests {
     #[test]
     fn normals_are_scored_on_objects_and_by_type() {
         let n = |v: [f32; 3]| v;
-        let truth = Image::<f32, 3>::from_vec(3, 1, [n([0., 0., 1.]); 3].concat()).unwrap();
-        let est = Image::<f32, 3>::from_vec(
+        let truth = NormalImage::from_vec(3, 1, [n([0., 0., 1.]); 3].concat()).unwrap();
+        let est = NormalImage::from_vec(
             3,
             1,
             [n([0., 0., 1.]), n([1., 0., 0.]), n([0., 1., 0.])].concat(),

@@ -1,13 +1,21 @@
-//! Typed images. The channel count is part of the type (`Image<T, C>`), so a
-//! 4-channel Stokes image and a 1-channel DoLP image cannot be mixed up.
-//! Pixels are stored row-major and interleaved; row 0 is the top row.
+//! Typed images. The channel count and the meaning of the channels are part of the type
+//! (`Image<T, C, K>`, `K` a marker of [`kind`]), so a 4-channel Stokes image, a stack of
+//! the four polarizer images and a 1-channel DoLP plane cannot be mixed up.
+//! Pixels are stored row-major and interleaved; row 0 is the top row. [`ImageView`]
+//! borrows any image (or a rectangle of one) without its kind, for generic code.
 
 mod border;
+pub mod kind;
 mod quantile;
+mod view;
+
+use std::marker::PhantomData;
 
 pub use border::Border;
+pub use kind::Plain;
 pub use quantile::quantile;
 use thiserror::Error;
+pub use view::ImageView;
 
 /// Errors from constructing or combining images.
 #[derive(Debug, Error, PartialEq, Eq)]
@@ -29,37 +37,84 @@ pub enum ImageError {
     /// Two images that must have the same size do not.
     #[error("size mismatch: {0}x{1} vs {2}x{3}")]
     SizeMismatch(usize, usize, usize, usize),
+    /// A view's rows do not fit its buffer, or its stride is less than its width.
+    #[error(
+        "a {width}x{height} view with {channels} channel(s) and a row stride of {stride} pixels does not fit a buffer of {len} values"
+    )]
+    ViewBounds {
+        /// Buffer length given.
+        len: usize,
+        /// View width.
+        width: usize,
+        /// View height.
+        height: usize,
+        /// Pixels from one row start to the next.
+        stride: usize,
+        /// Channels per pixel.
+        channels: usize,
+    },
+    /// A crop rectangle reaches outside the view it is cut from.
+    #[error(
+        "a {width}x{height} crop at ({x}, {y}) reaches outside the {outer_width}x{outer_height} view"
+    )]
+    CropBounds {
+        /// Left column of the crop.
+        x: usize,
+        /// Top row of the crop.
+        y: usize,
+        /// Crop width.
+        width: usize,
+        /// Crop height.
+        height: usize,
+        /// Width of the view cut from.
+        outer_width: usize,
+        /// Height of the view cut from.
+        outer_height: usize,
+    },
 }
 
-/// A `width × height` image with `C` interleaved channels of type `T`.
+/// A `width × height` image with `C` interleaved channels of type `T` that mean `K`
+/// (a marker of [`kind`]; [`Plain`] when the image has no particular meaning).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Image<T, const C: usize> {
+pub struct Image<T, const C: usize, K = Plain> {
     width: usize,
     height: usize,
     data: Vec<T>,
+    kind: PhantomData<K>,
 }
 
-/// A single-channel image (mosaic, DoLP, AoLP, depth, mask, ...).
+/// A single-channel image without a particular meaning (DoLP, AoLP, depth, mask, ...).
 pub type Gray<T> = Image<T, 1>;
 /// Linear Stokes `S0, S1, S2` per pixel.
-pub type LinearStokesImage = Image<f32, 3>;
+pub type LinearStokesImage = Image<f32, 3, kind::LinearStokes>;
 /// Full Stokes `S0, S1, S2, S3` per pixel.
-pub type StokesImage = Image<f32, 4>;
+pub type StokesImage = Image<f32, 4, kind::Stokes>;
 /// The four polarizer images `I0, I45, I90, I135` per pixel.
-pub type PolarizerStack = Image<f32, 4>;
+pub type PolarizerStack = Image<f32, 4, kind::Polarizers>;
+/// Unit camera-frame surface normals `x, y, z` per pixel (`0, 0, 0` where no surface).
+pub type NormalImage = Image<f32, 3, kind::Normals>;
+/// A raw division-of-focal-plane mosaic with samples of type `T` (`u8` or `u16` DN).
+pub type Mosaic<T> = Image<T, 1, kind::RawMosaic>;
 
-impl<T: Clone + Default, const C: usize> Image<T, C> {
+impl<T: Clone + Default, const C: usize, K> Image<T, C, K> {
     /// An image filled with `T::default()`.
     pub fn new(width: usize, height: usize) -> Self {
-        Self {
-            width,
-            height,
-            data: vec![T::default(); width * height * C],
-        }
+        Self::wrap(width, height, vec![T::default(); width * height * C])
     }
 }
 
-impl<T, const C: usize> Image<T, C> {
+impl<T, const C: usize, K> Image<T, C, K> {
+    /// The image of a buffer whose length is already known to fit.
+    fn wrap(width: usize, height: usize, data: Vec<T>) -> Self {
+        debug_assert_eq!(data.len(), width * height * C);
+        Self {
+            width,
+            height,
+            data,
+            kind: PhantomData,
+        }
+    }
+
     /// Wraps an interleaved row-major buffer, checking its length.
     pub fn from_vec(width: usize, height: usize, data: Vec<T>) -> Result<Self, ImageError> {
         if data.len() != width * height * C {
@@ -70,11 +125,19 @@ impl<T, const C: usize> Image<T, C> {
                 channels: C,
             });
         }
-        Ok(Self {
-            width,
-            height,
-            data,
-        })
+        Ok(Self::wrap(width, height, data))
+    }
+
+    /// The same pixels as an image of kind `K2`, without copying: the one explicit way
+    /// to change what an image means (e.g. a plain 4-channel result into a Stokes image).
+    pub fn into_kind<K2>(self) -> Image<T, C, K2> {
+        Image::wrap(self.width, self.height, self.data)
+    }
+
+    /// The whole image as a borrowed view (no copy, no kind).
+    pub fn view(&self) -> ImageView<'_, T, C> {
+        ImageView::new(&self.data, self.width, self.height, self.width)
+            .expect("an image's buffer fits its size")
     }
 
     /// Width in pixels.
@@ -123,9 +186,9 @@ impl<T, const C: usize> Image<T, C> {
     }
 
     /// Checks that `other` has the same size.
-    pub fn check_same_size<U, const D: usize>(
+    pub fn check_same_size<U, const D: usize, L>(
         &self,
-        other: &Image<U, D>,
+        other: &Image<U, D, L>,
     ) -> Result<(), ImageError> {
         if self.size() == other.size() {
             Ok(())
@@ -140,16 +203,12 @@ impl<T, const C: usize> Image<T, C> {
     }
 }
 
-impl<T: Copy, const C: usize> Image<T, C> {
+impl<T: Copy, const C: usize, K> Image<T, C, K> {
     /// Channel `c` as a new single-channel image.
     pub fn channel(&self, c: usize) -> Gray<T> {
         assert!(c < C, "channel {c} out of range for a {C}-channel image");
         let data = self.pixels().iter().map(|p| p[c]).collect();
-        Gray {
-            width: self.width,
-            height: self.height,
-            data,
-        }
+        Gray::wrap(self.width, self.height, data)
     }
 
     /// Builds a `C`-channel image from `C` single-channel images of equal size.
@@ -162,11 +221,7 @@ impl<T: Copy, const C: usize> Image<T, C> {
         for i in 0..w * h {
             data.extend(channels.iter().map(|ch| ch.data[i]));
         }
-        Ok(Self {
-            width: w,
-            height: h,
-            data,
-        })
+        Ok(Self::wrap(w, h, data))
     }
 }
 

@@ -84,9 +84,9 @@ pub enum Error {
 }
 
 /// Checks that two images have the same size.
-pub(crate) fn same_size<T, U, const C: usize, const D: usize>(
-    a: &polar_image::Image<T, C>,
-    b: &polar_image::Image<U, D>,
+pub(crate) fn same_size<T, U, const C: usize, const D: usize, K, L>(
+    a: &polar_image::Image<T, C, K>,
+    b: &polar_image::Image<U, D, L>,
 ) -> Result<(), Error> {
     if a.size() != b.size() {
         return Err(Error::SizeMismatch(

@@ -1,7 +1,7 @@
 //! Image-quality and task metrics: PSNR, SSIM (as scikit-image computes them), angular
 //! error of normal maps, IoU and confusion matrices.
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use rayon::prelude::*;
 
 use crate::{BAND_ROWS, Border, Error, same_size};
@@ -210,8 +210,8 @@ pub struct AngularErrorStats {
 /// non-zero and both normals have non-zero length (the sample format writes `0,0,0` where
 /// there is no surface). Returns `None` if no pixel qualifies.
 pub fn angular_error(
-    est: &Image<f32, 3>,
-    truth: &Image<f32, 3>,
+    est: &NormalImage,
+    truth: &NormalImage,
     mask: Option<&Gray<u8>>,
 ) -> Result<Option<AngularErrorStats>, Error> {
     same_size(est, truth)?;
@@ -378,8 +378,8 @@ mod tests {
 
     #[test]
     fn right_angle_normals_and_confusion() {
-        let est = Image::<f32, 3>::from_vec(2, 1, vec![1.0, 0.0, 0.0, 0.0, 0.0, 2.0]).unwrap();
-        let gt = Image::<f32, 3>::from_vec(2, 1, vec![0.0, 1.0, 0.0, 0.0, 0.0, 1.0]).unwrap();
+        let est = NormalImage::from_vec(2, 1, vec![1.0, 0.0, 0.0, 0.0, 0.0, 2.0]).unwrap();
+        let gt = NormalImage::from_vec(2, 1, vec![0.0, 1.0, 0.0, 0.0, 0.0, 1.0]).unwrap();
         let s = angular_error(&est, &gt, None).unwrap().unwrap();
         assert!((s.mean - 45.0).abs() < 1e-12 && (s.median - 45.0).abs() < 1e-12);
         assert_eq!((s.pct_below_11_25, s.pct_below_30), (50.0, 50.0));

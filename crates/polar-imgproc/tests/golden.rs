@@ -18,7 +18,7 @@
 
 use std::path::PathBuf;
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use polar_imgproc::*;
 use serde_json::Value;
 
@@ -392,7 +392,7 @@ fn angular_error_iou_and_confusion_match_numpy() {
     let case = g.cases("angular_error")[0];
     let normals = |k: &str| {
         let (v, s) = g.f32s(&g.input(case, k));
-        Image::<f32, 3>::from_vec(s[1], s[0], v).unwrap()
+        NormalImage::from_vec(s[1], s[0], v).unwrap()
     };
     let mask = g.gray_u8(&g.input(case, "mask"));
     let s = angular_error(&normals("est"), &normals("truth"), Some(&mask))

@@ -48,7 +48,7 @@ fn bench_io(c: &mut Criterion) {
         b.iter(|| write_gray16_png(&png16, &mosaic).unwrap())
     });
     g.bench_function("read_stokes_exr", |b| {
-        b.iter(|| read_exr(&exr, STOKES_CHANNELS).unwrap())
+        b.iter(|| -> StokesImage { read_exr(&exr, STOKES_CHANNELS).unwrap() })
     });
     g.bench_function("write_stokes_exr", |b| {
         b.iter(|| write_exr(&exr, &stokes, STOKES_CHANNELS).unwrap())

@@ -48,18 +48,18 @@ impl ExrCompression {
 /// Writes `image` as a single-layer float32 EXR whose channel `c` is named `names[c]`,
 /// atomically, with the default [`ExrCompression`]. Names must be non-empty, distinct and
 /// Latin-1 (an EXR rule).
-pub fn write_exr<const C: usize>(
+pub fn write_exr<const C: usize, K>(
     path: impl AsRef<Path>,
-    image: &Image<f32, C>,
+    image: &Image<f32, C, K>,
     names: [&str; C],
 ) -> Result<()> {
     write_exr_with(path, image, names, ExrCompression::default())
 }
 
 /// [`write_exr`] with a chosen compression.
-pub fn write_exr_with<const C: usize>(
+pub fn write_exr_with<const C: usize, K>(
     path: impl AsRef<Path>,
-    image: &Image<f32, C>,
+    image: &Image<f32, C, K>,
     names: [&str; C],
     compression: ExrCompression,
 ) -> Result<()> {
@@ -179,20 +179,24 @@ fn write_image<'c, C: WritableChannels<'c>>(
     })
 }
 
-/// Reads the channels `names` (in that order) of a single-layer EXR into a `C`-channel image.
+/// Reads the channels `names` (in that order) of a single-layer EXR into a `C`-channel image
+/// of the kind the caller asks for (e.g. a `StokesImage` for [`crate::STOKES_CHANNELS`]).
 /// A channel the file lacks gives [`Error::MissingChannel`], naming the channels present.
-pub fn read_exr<const C: usize>(path: impl AsRef<Path>, names: [&str; C]) -> Result<Image<f32, C>> {
+pub fn read_exr<const C: usize, K>(
+    path: impl AsRef<Path>,
+    names: [&str; C],
+) -> Result<Image<f32, C, K>> {
     let path = path.as_ref();
     let file = File::open(path).map_err(|e| Error::io(path, "EXR", e))?;
     read_exr_from(path, BufReader::new(file), names)
 }
 
 /// [`read_exr`] from any buffered reader (e.g. bytes in memory); `path` only names it in errors.
-pub fn read_exr_from<const C: usize>(
+pub fn read_exr_from<const C: usize, K>(
     path: &Path,
     reader: impl Read + Seek,
     names: [&str; C],
-) -> Result<Image<f32, C>> {
+) -> Result<Image<f32, C, K>> {
     let layer = read_single_layer(path, reader)?;
     let (width, height) = (layer.size.0, layer.size.1);
     let planes = names.map(|name| find_channel(path, &layer, name));

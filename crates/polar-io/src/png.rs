@@ -6,7 +6,8 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Seek, Write};
 use std::path::Path;
 
-use polar_image::{Gray, Image};
+use polar_image::kind::RawMosaic;
+use polar_image::{Gray, Image, Plain};
 
 use crate::atomic::write_file_atomic;
 use crate::error::{Error, Result};
@@ -42,14 +43,18 @@ impl BitDepth {
 }
 
 /// A grayscale PNG as read: samples widened to `u16` (values unchanged, not rescaled),
-/// plus the bit depth the file stored them at.
+/// plus the bit depth the file stored them at; `K` is what the image means
+/// ([`MosaicPng`] for a raw mosaic).
 #[derive(Clone, Debug, PartialEq)]
-pub struct GrayPng {
+pub struct GrayPng<K = Plain> {
     /// The samples, row 0 at the top.
-    pub image: Gray<u16>,
+    pub image: Image<u16, 1, K>,
     /// The depth in the file; every sample is `<= bit_depth.max_value()`.
     pub bit_depth: BitDepth,
 }
+
+/// A raw division-of-focal-plane mosaic as read from its PNG ([`read_mosaic`]).
+pub type MosaicPng = GrayPng<RawMosaic>;
 
 /// Reads an 8- or 16-bit grayscale PNG. Colour PNGs give [`Error::ColorType`],
 /// 1/2/4-bit ones [`Error::BitDepth`] (their values would need rescaling to mean DN).
@@ -107,16 +112,19 @@ fn gray_of_depth(
 
 /// Reads a division-of-focal-plane mosaic: an 8- or 16-bit grayscale PNG whose width and
 /// height are even and at least 2 (whole 2x2 super-pixels, layout in the conventions).
-pub fn read_mosaic(path: impl AsRef<Path>) -> Result<GrayPng> {
+pub fn read_mosaic(path: impl AsRef<Path>) -> Result<MosaicPng> {
     let path = path.as_ref();
     read_mosaic_from(path, open(path)?)
 }
 
 /// [`read_mosaic`] from any reader (e.g. bytes in memory); `path` only names it in errors.
-pub fn read_mosaic_from(path: &Path, reader: impl BufRead + Seek) -> Result<GrayPng> {
+pub fn read_mosaic_from(path: &Path, reader: impl BufRead + Seek) -> Result<MosaicPng> {
     let png = read_gray_png_from(path, reader)?;
     check_mosaic_size(path, png.image.width(), png.image.height())?;
-    Ok(png)
+    Ok(MosaicPng {
+        image: png.image.into_kind(),
+        bit_depth: png.bit_depth,
+    })
 }
 
 /// Checks that a `width x height` mosaic holds whole 2x2 super-pixels.
@@ -147,7 +155,7 @@ pub fn read_rgb8_png(path: impl AsRef<Path>) -> Result<Image<u8, 3>> {
 }
 
 /// Writes an 8-bit grayscale PNG, atomically.
-pub fn write_gray8_png(path: impl AsRef<Path>, image: &Gray<u8>) -> Result<()> {
+pub fn write_gray8_png<K>(path: impl AsRef<Path>, image: &Image<u8, 1, K>) -> Result<()> {
     let bytes = image.as_slice();
     let layout = Layout::new(
         image.size(),
@@ -160,7 +168,7 @@ pub fn write_gray8_png(path: impl AsRef<Path>, image: &Gray<u8>) -> Result<()> {
 }
 
 /// Writes a 16-bit grayscale PNG, atomically.
-pub fn write_gray16_png(path: impl AsRef<Path>, image: &Gray<u16>) -> Result<()> {
+pub fn write_gray16_png<K>(path: impl AsRef<Path>, image: &Image<u16, 1, K>) -> Result<()> {
     let samples = image.as_slice();
     let layout = Layout::new(
         image.size(),
@@ -177,7 +185,7 @@ pub fn write_gray16_png(path: impl AsRef<Path>, image: &Gray<u16>) -> Result<()>
 
 /// Writes `png.image` at `png.bit_depth`; at 8 bits a sample above 255 gives
 /// [`Error::ValueRange`] (never silently clipped).
-pub fn write_gray_png(path: impl AsRef<Path>, png: &GrayPng) -> Result<()> {
+pub fn write_gray_png<K>(path: impl AsRef<Path>, png: &GrayPng<K>) -> Result<()> {
     let path = path.as_ref();
     match png.bit_depth {
         BitDepth::Sixteen => write_gray16_png(path, &png.image),
@@ -209,7 +217,7 @@ pub fn write_rgb8_png_rows(
 const ROW_BLOCK: usize = 64;
 
 /// `u16` samples as `u8`, failing on the first that does not fit.
-fn narrow_to_u8(path: &Path, image: &Gray<u16>) -> Result<Gray<u8>> {
+fn narrow_to_u8<K>(path: &Path, image: &Image<u16, 1, K>) -> Result<Image<u8, 1, K>> {
     let width = image.width().max(1);
     let data = image
         .as_slice()
@@ -228,8 +236,12 @@ fn narrow_to_u8(path: &Path, image: &Gray<u16>) -> Result<Gray<u8>> {
     gray_from_vec(path, image.size(), data)
 }
 
-fn gray_from_vec<T>(path: &Path, (width, height): (usize, usize), data: Vec<T>) -> Result<Gray<T>> {
-    Gray::from_vec(width, height, data).map_err(|e| Error::corrupt(path, "PNG", e))
+fn gray_from_vec<T, K>(
+    path: &Path,
+    (width, height): (usize, usize),
+    data: Vec<T>,
+) -> Result<Image<T, 1, K>> {
+    Image::from_vec(width, height, data).map_err(|e| Error::corrupt(path, "PNG", e))
 }
 
 fn u16_from_be_bytes(bytes: &[u8]) -> Vec<u16> {

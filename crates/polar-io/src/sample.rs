@@ -5,13 +5,13 @@
 
 use std::path::{Path, PathBuf};
 
-use polar_image::{Gray, Image, StokesImage};
+use polar_image::{Gray, Image, NormalImage, StokesImage};
 use serde_json::{Map, Value};
 
 use crate::atomic::write_atomic;
 use crate::error::{Error, Result};
 use crate::png::{
-    GrayPng, check_mosaic_size, read_gray8_png, read_mosaic, write_gray_png, write_gray8_png,
+    MosaicPng, check_mosaic_size, read_gray8_png, read_mosaic, write_gray_png, write_gray8_png,
 };
 use crate::staged::StagedDir;
 use crate::validate::{Rule, Validation, check_channels, check_stokes, check_u8};
@@ -166,7 +166,7 @@ pub const TRANSPARENT_MASK_ON: u8 = 255;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct GroundTruth {
     /// `gt/normal.exr`.
-    pub normal: Option<Image<f32, 3>>,
+    pub normal: Option<NormalImage>,
     /// `gt/depth.exr`.
     pub depth: Option<Gray<f32>>,
     /// `gt/material.png`.
@@ -187,7 +187,7 @@ pub struct Sample {
     /// `meta.json`: size, sensor, camera, scene, renderer, spp, seconds, and any other keys.
     pub meta: Map<String, Value>,
     /// `raw.png`, with the bit depth it is stored at.
-    pub raw: Option<GrayPng>,
+    pub raw: Option<MosaicPng>,
     /// `stokes.exr`.
     pub stokes: Option<StokesImage>,
     /// `gt/`.

@@ -52,9 +52,9 @@ impl Rule {
 
 /// Checks every pixel of `image` against `rules[c]` for channel `c` (named `names[c]` in the
 /// error). `path` is the file the image came from or goes to.
-pub fn check_channels<const C: usize>(
+pub fn check_channels<const C: usize, K>(
     path: &Path,
-    image: &Image<f32, C>,
+    image: &Image<f32, C, K>,
     names: [&str; C],
     rules: [Rule; C],
 ) -> Result<()> {

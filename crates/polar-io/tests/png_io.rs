@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use polar_image::{Gray, Image};
 use polar_io::{
-    BitDepth, Error, GrayPng, read_gray_png, read_gray8_png, read_mosaic, read_rgb8_png,
+    BitDepth, Error, GrayPng, MosaicPng, read_gray_png, read_gray8_png, read_mosaic, read_rgb8_png,
     write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png, write_rgb8_png_rows,
 };
 
@@ -70,8 +70,8 @@ fn gray16_round_trip_is_exact() {
     let back = read_mosaic(&path).unwrap();
     assert_eq!(
         back,
-        GrayPng {
-            image: img,
+        MosaicPng {
+            image: img.into_kind(),
             bit_depth: BitDepth::Sixteen
         }
     );

@@ -2,9 +2,9 @@
 
 use std::path::Path;
 
-use polar_image::{Gray, Image, StokesImage};
+use polar_image::{Gray, Image, Mosaic, StokesImage};
 use polar_io::{
-    BitDepth, Error, GrayPng, GroundTruth, MaterialLabel, STOKES_CHANNELS, Sample, Validation,
+    BitDepth, Error, GroundTruth, MaterialLabel, MosaicPng, STOKES_CHANNELS, Sample, Validation,
     files, read_json, read_sample, read_sample_with, write_exr, write_gray8_png, write_gray16_png,
     write_json, write_sample,
 };
@@ -25,10 +25,10 @@ fn stokes() -> StokesImage {
     Image::from_vec(W, H, data).unwrap()
 }
 
-fn raw16() -> GrayPng {
+fn raw16() -> MosaicPng {
     let data = (0..W * H).map(|i| (i * 2731) as u16).collect();
-    GrayPng {
-        image: Gray::from_vec(W, H, data).unwrap(),
+    MosaicPng {
+        image: Mosaic::from_vec(W, H, data).unwrap(),
         bit_depth: BitDepth::Sixteen,
     }
 }
@@ -88,8 +88,8 @@ fn full_sample_round_trip_is_exact() {
 fn eight_bit_raw_round_trip_keeps_its_depth() {
     let root = tempfile::tempdir().unwrap();
     let data = (0..W * H).map(|i| (i * 11 % 256) as u16).collect();
-    let raw = GrayPng {
-        image: Gray::from_vec(W, H, data).unwrap(),
+    let raw = MosaicPng {
+        image: Mosaic::from_vec(W, H, data).unwrap(),
         bit_depth: BitDepth::Eight,
     };
     let sample = Sample {

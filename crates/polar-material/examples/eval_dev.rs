@@ -16,7 +16,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, Image, NormalImage};
 use polar_imgproc::{ConfusionMatrix, iou};
 use polar_material::{Classifier, MaterialOptions, classify};
 use polar_optics::pixel_frame::CameraModel;
@@ -29,7 +29,7 @@ struct Case {
     noise: String,
     obs: Observation,
     truth: Gray<u8>,
-    normals: Option<Image<f32, 3>>,
+    normals: Option<NormalImage>,
 }
 
 fn load(dir: &Path, from_stokes: bool) -> Case {

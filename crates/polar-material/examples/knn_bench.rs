@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use polar_image::Image;
+use polar_image::LinearStokesImage;
 use polar_material::knn::{BUILTIN_MODEL, KnnClassifier};
 use polar_material::{Classifier, MaterialOptions, classify};
 use polar_optics::pixel_frame::CameraModel;
@@ -18,13 +18,13 @@ use polar_sensor::{Observation, StokesPlanes};
 const SIDE: usize = 1024;
 
 fn tiled(sample: &Path) -> Observation {
-    let s = polar_io::read_exr(
+    let s: LinearStokesImage = polar_io::read_exr(
         sample.join(polar_io::files::STOKES),
         polar_io::LINEAR_STOKES_CHANNELS,
     )
     .expect("a sample directory with stokes.exr");
     let (w, h) = s.size();
-    let mut big = Image::<f32, 3>::new(SIDE, SIDE);
+    let mut big = LinearStokesImage::new(SIDE, SIDE);
     for y in 0..SIDE {
         for x in 0..SIDE {
             big.pixels_mut()[y * SIDE + x] = s.pixels()[(y % h) * w + x % w];

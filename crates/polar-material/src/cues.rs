@@ -9,7 +9,7 @@
 //! phase is measured in a band along the mask boundary, against the outward direction
 //! of the blurred mask's gradient.
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use polar_imgproc::gaussian_blur;
 use polar_sensor::Observation;
 
@@ -35,7 +35,7 @@ pub struct Cues {
 pub fn from_normals(
     obs: &Observation,
     f: &Features,
-    normals: &Image<f32, 3>,
+    normals: &NormalImage,
 ) -> Result<Cues, MaterialError> {
     let (w, h) = (f.width, f.height);
     if normals.size() != (w, h) {

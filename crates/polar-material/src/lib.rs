@@ -18,7 +18,7 @@ pub mod rule;
 
 use std::sync::Arc;
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use polar_io::MaterialLabel;
 use polar_sensor::Observation;
 use thiserror::Error;
@@ -109,7 +109,7 @@ pub struct MaterialMap {
 /// are labelled [`TRANSPARENT`] and left out of the opaque classes.
 pub fn classify(
     obs: &Observation,
-    normals: Option<&Image<f32, 3>>,
+    normals: Option<&NormalImage>,
     foreground: Option<&Gray<u8>>,
     transparent: Option<&Gray<u8>>,
     clf: &Classifier,
@@ -152,7 +152,7 @@ pub fn classify(
 /// `transparent`) and cues (from `normals`, else from the silhouettes) of `obs`.
 pub fn prepare(
     obs: &Observation,
-    normals: Option<&Image<f32, 3>>,
+    normals: Option<&NormalImage>,
     foreground: Option<&Gray<u8>>,
     transparent: Option<&Gray<u8>>,
 ) -> Result<Prepared, MaterialError> {

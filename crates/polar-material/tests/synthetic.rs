@@ -2,7 +2,7 @@
 //! DoLP and AoLP that Fresnel's equations give for specular reflection (dielectric,
 //! metal) or diffuse emission (dielectric) of unpolarized light, and named hard cases.
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use polar_material::{
     BACKGROUND, Classifier, DIELECTRIC, METAL, MaterialOptions, TRANSPARENT, classify,
 };
@@ -12,7 +12,7 @@ use polar_sensor::{Observation, StokesPlanes};
 mod common;
 use common::*;
 
-fn run(obs: &Observation, normals: Option<&Image<f32, 3>>, fg: Option<&Gray<u8>>) -> Gray<u8> {
+fn run(obs: &Observation, normals: Option<&NormalImage>, fg: Option<&Gray<u8>>) -> Gray<u8> {
     classify(
         obs,
         normals,
@@ -207,7 +207,7 @@ fn per_pixel_labels_without_region_smoothing() {
 fn size_mismatch_is_an_error() {
     let obs = uniform(8, 8, 1.0, 0.0);
     let fg = Gray::<u8>::new(4, 8);
-    let n = Image::<f32, 3>::new(8, 4);
+    let n = NormalImage::new(8, 4);
     let opts = MaterialOptions::default();
     assert!(classify(&obs, None, Some(&fg), None, &Classifier::Physics, &opts).is_err());
     assert!(classify(&obs, Some(&n), None, None, &Classifier::Physics, &opts).is_err());

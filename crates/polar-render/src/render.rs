@@ -8,7 +8,7 @@ use crate::scene::{Light, Scene};
 use crate::transport::{Full, Linear, Scalar, Transport};
 use crate::world::World;
 use polar_bsdf::Material;
-use polar_image::{Gray, Image, StokesImage};
+use polar_image::{Gray, NormalImage, StokesImage};
 use polar_io::{MaterialLabel, TRANSPARENT_MASK_ON};
 use polar_optics::{Polarization, Stokes};
 use pulp::{Arch, Simd, WithSimd};
@@ -69,7 +69,7 @@ pub struct RenderOutput {
 #[derive(Clone, Debug)]
 pub struct FirstHit {
     /// Camera-frame unit normal of the first hit, facing the camera; 0 where no surface.
-    pub normal: Image<f32, 3>,
+    pub normal: NormalImage,
     /// Distance along the viewing axis (camera -z) to the first hit; 0 where no surface.
     pub depth: Gray<f32>,
     /// Material labels ([`MaterialLabel`] values).
@@ -398,7 +398,7 @@ fn assemble(scene: &Scene, tiles: Vec<TileResult>, pass: Pass) -> (StokesImage, 
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut stokes = StokesImage::new(w, h);
     let mut truth = pass.ground_truth.then(|| FirstHit {
-        normal: Image::new(w, h),
+        normal: NormalImage::new(w, h),
         depth: Gray::new(w, h),
         material: Gray::new(w, h),
         transparent: Gray::new(w, h),

@@ -10,7 +10,6 @@
 
 use std::time::{Duration, Instant};
 
-use polar_image::Gray;
 use polar_sensor::products::{StokesPlanes, simd_target, stokes_planes_into};
 use polar_sensor::{DemosaicMethod, Mosaic, MosaicSample};
 use rayon::prelude::*;
@@ -97,7 +96,7 @@ fn main() {
     let (w, h) = png.image.size();
     let bytes_per_sample = usize::from(png.bit_depth.bits() / 8);
     let results = if bytes_per_sample == 1 {
-        let raw8: Gray<u8> = Gray::from_vec(
+        let raw8: Mosaic<u8> = Mosaic::from_vec(
             w,
             h,
             png.image.as_slice().iter().map(|&v| v as u8).collect(),

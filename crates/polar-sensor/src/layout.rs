@@ -8,10 +8,9 @@
 //! This is the layout polanalyser calls `COLOR_PolarMono`. Channels of a
 //! [`polar_image::PolarizerStack`] are ordered `I0, I45, I90, I135`.
 
-use polar_image::Gray;
-
-/// A raw mosaic with samples of type `T` (`u8` or `u16`), in the layout above.
-pub type Mosaic<T> = Gray<T>;
+/// A raw mosaic with samples of type `T` (`u8` or `u16`), in the layout above: its own
+/// image kind, so it cannot be passed where a plain single-channel image is expected.
+pub use polar_image::Mosaic;
 
 /// Polarizer angles in degrees of the four stack channels, in channel order.
 pub const CHANNEL_ANGLES_DEG: [f64; 4] = [0.0, 45.0, 90.0, 135.0];

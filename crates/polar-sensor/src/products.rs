@@ -13,7 +13,7 @@
 //! selects, which IEEE 754 rounds identically at any vector width, and Rust never
 //! contracts `a * b + c` into an FMA on its own (a test compares the targets).
 
-use polar_image::{Gray, LinearStokesImage, PolarizerStack};
+use polar_image::{Gray, ImageView, LinearStokesImage, PolarizerStack};
 use polar_optics::LinearStokesFit;
 use polar_optics::stokes::{imax, imin, linear_stokes_from_quad};
 use pulp::{Arch, Simd, WithSimd};
@@ -254,9 +254,9 @@ pub fn stokes_planes_into<T: MosaicSample>(
     }
     match method {
         DemosaicMethod::Bilinear if w >= 4 && h >= 4 => {
-            fused_bilinear(raw.as_slice(), w, h, out, Arch::new())
+            fused_bilinear(raw.view(), out, Arch::new())
         }
-        DemosaicMethod::Residual => fused_residual(raw.as_slice(), w, h, out, Arch::new()),
+        DemosaicMethod::Residual => fused_residual(raw.view(), out, Arch::new()),
         _ => *out = StokesPlanes::from_stack(&demosaic(raw, method)?),
     }
     Ok(())
@@ -265,16 +265,10 @@ pub fn stokes_planes_into<T: MosaicSample>(
 /// The fused residual chain: the guide and the residual go into the DoLP and AoLP planes
 /// (scratch until the last pass), then each row is interpolated straight into `S0, S1,
 /// S2`, then DoLP and AoLP are derived; so no full-size temporary is allocated.
-fn fused_residual<T: MosaicSample>(
-    src: &[T],
-    w: usize,
-    h: usize,
-    out: &mut StokesPlanes,
-    arch: Arch,
-) {
-    let (guide, res) = (out.dolp.as_mut_slice(), out.aolp.as_mut_slice());
-    guide_and_residual(src, w, h, guide, res);
-    let (guide, res) = (out.dolp.as_slice(), out.aolp.as_slice());
+fn fused_residual<T: MosaicSample>(raw: ImageView<'_, T, 1>, out: &mut StokesPlanes, arch: Arch) {
+    let w = raw.width();
+    guide_and_residual(raw, &mut out.dolp, &mut out.aolp);
+    let (guide, res) = (out.dolp.view(), out.aolp.view());
     let [s0, s1, s2] = [&mut out.s0, &mut out.s1, &mut out.s2].map(|p| p.as_mut_slice());
     s0.par_chunks_mut(w)
         .zip(s1.par_chunks_mut(w))
@@ -282,11 +276,9 @@ fn fused_residual<T: MosaicSample>(
         .enumerate()
         .for_each(|(y, ((a, b), c))| {
             arch.dispatch(ResidualRow {
-                src,
+                raw,
                 guide,
                 res,
-                w,
-                h,
                 y,
                 sink: StokesRow([a, b, c]),
             })
@@ -295,32 +287,18 @@ fn fused_residual<T: MosaicSample>(
         .for_each(|[s0, s1, s2, d, a]| derived_row(s0, s1, s2, d, a));
 }
 
-/// The fused bilinear chain on planes of the mosaic size (`w, h >= 4`), one rayon task
-/// and one SIMD dispatch per row, each row's kernels compiled for `arch`.
-fn fused_bilinear<T: MosaicSample>(
-    src: &[T],
-    w: usize,
-    h: usize,
-    out: &mut StokesPlanes,
-    arch: Arch,
-) {
-    out.rows_mut().enumerate().for_each(|(y, planes)| {
-        arch.dispatch(FusedRow {
-            src,
-            w,
-            h,
-            y,
-            planes,
-        })
-    });
+/// The fused bilinear chain on planes of the mosaic size (width and height `>= 4`), one
+/// rayon task and one SIMD dispatch per row, each row's kernels compiled for `arch`.
+fn fused_bilinear<T: MosaicSample>(raw: ImageView<'_, T, 1>, out: &mut StokesPlanes, arch: Arch) {
+    out.rows_mut()
+        .enumerate()
+        .for_each(|(y, planes)| arch.dispatch(FusedRow { raw, y, planes }));
 }
 
 /// One output row `y` of [`fused_bilinear`] as a `pulp` operation (see [`DerivedRow`]):
 /// `planes` are the rows of `S0, S1, S2, DoLP, AoLP`.
 struct FusedRow<'a, T> {
-    src: &'a [T],
-    w: usize,
-    h: usize,
+    raw: ImageView<'a, T, 1>,
     y: usize,
     planes: [&'a mut [f32]; 5],
 }
@@ -331,7 +309,7 @@ impl<T: MosaicSample> WithSimd for FusedRow<'_, T> {
     #[inline(always)]
     fn with_simd<S: Simd>(self, _: S) {
         let [s0, s1, s2, d, a] = self.planes;
-        bilinear_stokes_row(self.src, self.w, self.h, self.y, [s0, s1, s2]);
+        bilinear_stokes_row(self.raw, self.y, [s0, s1, s2]);
         dolp_aolp_row(s0, s1, s2, d, a);
     }
 }
@@ -391,7 +369,7 @@ mod tests {
         fn run<T: MosaicSample>(raw: &Mosaic<T>, arch: Arch) -> StokesPlanes {
             let (w, h) = raw.size();
             let mut out = StokesPlanes::new(w, h);
-            fused_bilinear(raw.as_slice(), w, h, &mut out, arch);
+            fused_bilinear(raw.view(), &mut out, arch);
             out
         }
         for name in ["carps_IMX250MZR.png", "camera_IMX250MZR.png"] {

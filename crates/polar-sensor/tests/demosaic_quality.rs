@@ -6,7 +6,7 @@ mod common;
 use common::demosaic_eval::{Errors, Field, errors, truth_stokes};
 use polar_sensor::mask::validity_mask;
 use polar_sensor::products::StokesPlanes;
-use polar_sensor::{DemosaicMethod, SensorModel, demosaic};
+use polar_sensor::{DemosaicMethod, Mosaic, SensorModel, demosaic};
 
 fn measure(field: Field, method: DemosaicMethod) -> Errors {
     // 256x192: the 1024x768 design scaled by 1/4 (edges, zone plate to Nyquist, stripes).
@@ -58,7 +58,7 @@ fn residual_s0_close_to_bilinear_on_real_frames() {
             "{}/../../tests/data/real/{name}.png",
             env!("CARGO_MANIFEST_DIR")
         );
-        let raw = polar_io::read_gray8_png(&path).unwrap();
+        let raw: Mosaic<u8> = polar_io::read_gray8_png(&path).unwrap().into_kind();
         let s0 = |m| StokesPlanes::from_stack(&demosaic(&raw, m).unwrap()).s0;
         let (b, r) = (s0(DemosaicMethod::Bilinear), s0(DemosaicMethod::Residual));
         let mask = validity_mask(&raw, 255, DemosaicMethod::Residual, &r);

@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, Image, NormalImage};
 use polar_imgproc::angular_error;
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::mask::validity_mask;
@@ -183,7 +183,7 @@ fn main() {
     }
 }
 
-fn count_missing(n: &Image<f32, 3>, mask: &Gray<u8>) -> usize {
+fn count_missing(n: &NormalImage, mask: &Gray<u8>) -> usize {
     n.pixels()
         .iter()
         .zip(mask.as_slice())
@@ -196,7 +196,7 @@ fn debug_pictures(
     name: &str,
     m: &str,
     shape: &polar_shape::Shape,
-    gt: &Image<f32, 3>,
+    gt: &NormalImage,
     mask: &Gray<u8>,
 ) {
     std::fs::create_dir_all(dir).unwrap();
@@ -271,7 +271,7 @@ fn upscale(src: &Image<u8, 3>, f: usize) -> Image<u8, 3> {
 }
 
 /// Mean absolute zenith error and mean absolute azimuth error (degrees) in the pixel frames.
-fn split_error(est: &Image<f32, 3>, gt: &Image<f32, 3>, mask: &Gray<u8>, fov: f64) -> (f64, f64) {
+fn split_error(est: &NormalImage, gt: &NormalImage, mask: &Gray<u8>, fov: f64) -> (f64, f64) {
     let cam = CameraModel::Pinhole { fov_x_deg: fov };
     let (w, h) = est.size();
     let (mut sz, mut sa, mut n) = (0.0, 0.0, 0.0);
@@ -296,7 +296,7 @@ fn split_error(est: &Image<f32, 3>, gt: &Image<f32, 3>, mask: &Gray<u8>, fov: f6
 
 /// Times both methods on a sample upscaled (nearest neighbour) to 1024² and 512².
 fn speed(dir: &Path) {
-    let img = polar_io::read_exr(
+    let img: polar_image::LinearStokesImage = polar_io::read_exr(
         dir.join(polar_io::files::STOKES),
         polar_io::LINEAR_STOKES_CHANNELS,
     )

@@ -35,7 +35,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use nalgebra::Vector3;
-use polar_image::{Gray, Image};
+use polar_image::{Gray, Image, NormalImage};
 use polar_sensor::Observation;
 use thiserror::Error;
 
@@ -179,7 +179,7 @@ pub enum ReflectionType {
 pub struct Shape {
     /// Unit camera-frame normals (R, G, B = x, y, z; z > 0 faces the camera), `0,0,0`
     /// where there is no estimate.
-    pub normal: Image<f32, 3>,
+    pub normal: NormalImage,
     /// Relative depth (larger = farther), NaN outside the foreground.
     pub depth: Gray<f32>,
     /// Confidence in `[0, 1]` of each normal (0 where there is none).
@@ -248,7 +248,7 @@ pub struct Estimate {
 }
 
 /// Interleaved `f32` normal image from per-pixel vectors.
-fn normal_image(w: usize, h: usize, normals: &[Vector3<f64>]) -> Image<f32, 3> {
+fn normal_image(w: usize, h: usize, normals: &[Vector3<f64>]) -> NormalImage {
     let data = normals
         .iter()
         .flat_map(|n| [n.x as f32, n.y as f32, n.z as f32])

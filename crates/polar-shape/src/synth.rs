@@ -96,7 +96,7 @@ impl Scene {
     }
 
     /// True normals as an image.
-    pub fn normal_image(&self) -> polar_image::Image<f32, 3> {
+    pub fn normal_image(&self) -> polar_image::NormalImage {
         let data = self
             .normals
             .iter()

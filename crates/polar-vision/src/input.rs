@@ -8,9 +8,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use polar_image::Gray;
+use polar_image::Mosaic;
 use polar_io::files;
-use polar_io::{GrayPng, LINEAR_STOKES_CHANNELS};
+use polar_io::{LINEAR_STOKES_CHANNELS, MosaicPng};
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::mask::{count_saturated, validity_mask};
 use polar_sensor::{DemosaicMethod, Observation, StokesPlanes, stokes_planes};
@@ -167,7 +167,7 @@ pub fn camera_model(fov: Option<f64>, meta: Option<&Map<String, Value>>) -> Came
 /// level the frame itself shows. A 16-bit PNG may hold 10- or 12-bit data (a camera's
 /// ADC): where the frame's maximum is `2^b − 1` for a smaller `b >= 8` and at least two
 /// pixels hold it, those pixels are clipped at the ADC's top and are flagged.
-pub fn saturation_level(raw: &Gray<u16>, bits: u8) -> u32 {
+pub fn saturation_level(raw: &Mosaic<u16>, bits: u8) -> u32 {
     let full = (1u32 << bits) - 1;
     let max = raw.as_slice().iter().copied().max().map_or(0, u32::from);
     let at_max = raw
@@ -182,10 +182,10 @@ pub fn saturation_level(raw: &Gray<u16>, bits: u8) -> u32 {
 /// Applies `--bit-depth`/`--align`: returns the samples as right-aligned DN and their bit count.
 fn significant_bits(
     path: &Path,
-    png: GrayPng,
+    png: MosaicPng,
     bits: Option<u8>,
     align: Align,
-) -> Result<(Gray<u16>, u8), CliError> {
+) -> Result<(Mosaic<u16>, u8), CliError> {
     let container = png.bit_depth.bits();
     let bits = bits.unwrap_or(container);
     if bits > container {
@@ -238,7 +238,7 @@ fn significant_bits(
 /// Rejects frames without usable light; a warning for partly saturated ones.
 fn check_exposure(
     path: &Path,
-    raw: &Gray<u16>,
+    raw: &Mosaic<u16>,
     bits: u8,
     level: u32,
 ) -> Result<Option<String>, CliError> {
@@ -270,7 +270,7 @@ mod tests {
 
     #[test]
     fn saturation_at_a_smaller_adc_top_is_found_only_when_repeated() {
-        let img = |v: Vec<u16>| Gray::from_vec(v.len(), 1, v).unwrap();
+        let img = |v: Vec<u16>| Mosaic::from_vec(v.len(), 1, v).unwrap();
         assert_eq!(saturation_level(&img(vec![4095, 4095, 10]), 16), 4095);
         assert_eq!(saturation_level(&img(vec![4095, 4000, 10]), 16), 65535);
         assert_eq!(saturation_level(&img(vec![4094, 4094, 10]), 16), 65535);

@@ -1,10 +1,10 @@
 //! 8-bit pictures of the task outputs, for people (written under `pictures/`).
 
-use polar_image::{Gray, Image, quantile};
+use polar_image::{Gray, Image, NormalImage, quantile};
 use polar_sensor::picture::colormap;
 
 /// Normals as colours: `(n + 1) / 2` per axis (x red, y green, z blue); black where none.
-pub fn normal_picture(normals: &Image<f32, 3>) -> Image<u8, 3> {
+pub fn normal_picture(normals: &NormalImage) -> Image<u8, 3> {
     map_rgb(normals.size(), normals.pixels(), |n| {
         if n.iter().all(|&v| v == 0.0) || n.iter().any(|v| !v.is_finite()) {
             [0, 0, 0]
@@ -93,7 +93,7 @@ mod tests {
 
     #[test]
     fn normals_map_to_colours_and_missing_ones_to_black() {
-        let n = Image::<f32, 3>::from_vec(2, 1, vec![0.0, 0.0, 1.0, 0.0, 0.0, 0.0]).unwrap();
+        let n = NormalImage::from_vec(2, 1, vec![0.0, 0.0, 1.0, 0.0, 0.0, 0.0]).unwrap();
         let p = normal_picture(&n);
         assert_eq!(p.pixels(), &[[128, 128, 255], [0, 0, 0]]);
     }

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use polar_image::Gray;
+use polar_image::Mosaic;
 use polar_io::files::{self, vision};
 use polar_sensor::{DemosaicMethod, stokes_planes};
 
@@ -29,8 +29,8 @@ fn fails_with(args: &[&str], needle: &str) {
     );
 }
 
-fn mosaic8(w: usize, h: usize) -> Gray<u8> {
-    Gray::from_vec(
+fn mosaic8(w: usize, h: usize) -> Mosaic<u8> {
+    Mosaic::from_vec(
         w,
         h,
         (0..w * h)
@@ -129,7 +129,7 @@ fn sample_directory_with_raw_png_or_only_stokes_exr() {
 fn odd_tiny_zero_and_saturated_frames_are_rejected() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let case = |name: &str, img: Gray<u8>| -> PathBuf {
+    let case = |name: &str, img: Mosaic<u8>| -> PathBuf {
         let path = dir.path().join(name);
         polar_io::write_gray8_png(&path, &img).unwrap();
         path
@@ -138,9 +138,9 @@ fn odd_tiny_zero_and_saturated_frames_are_rejected() {
     fails_with(&["stokes", p(&odd), "--out", p(&out)], "must be even");
     let tiny = case("tiny.png", mosaic8(1, 1));
     fails_with(&["stokes", p(&tiny), "--out", p(&out)], "1x1");
-    let zero = case("zero.png", Gray::new(8, 8));
+    let zero = case("zero.png", Mosaic::new(8, 8));
     fails_with(&["stokes", p(&zero), "--out", p(&out)], "every pixel is 0");
-    let sat = case("sat.png", Gray::from_vec(8, 8, vec![255; 64]).unwrap());
+    let sat = case("sat.png", Mosaic::from_vec(8, 8, vec![255; 64]).unwrap());
     fails_with(
         &["stokes", p(&sat), "--out", p(&out)],
         "every pixel is saturated",
@@ -161,13 +161,13 @@ fn odd_tiny_zero_and_saturated_frames_are_rejected() {
 #[test]
 fn twelve_bit_data_left_or_right_aligned_in_16_bit_png() {
     let dir = tempfile::tempdir().unwrap();
-    let right: Gray<u16> = Gray::from_vec(
+    let right: Mosaic<u16> = Mosaic::from_vec(
         8,
         8,
         (0..64).map(|i| (100 + i * 61 % 3900) as u16).collect(),
     )
     .unwrap();
-    let left = Gray::from_vec(8, 8, right.as_slice().iter().map(|v| v << 4).collect()).unwrap();
+    let left = Mosaic::from_vec(8, 8, right.as_slice().iter().map(|v| v << 4).collect()).unwrap();
     let (rp, lp) = (dir.path().join("right.png"), dir.path().join("left.png"));
     polar_io::write_gray16_png(&rp, &right).unwrap();
     polar_io::write_gray16_png(&lp, &left).unwrap();

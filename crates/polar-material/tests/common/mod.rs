@@ -3,7 +3,7 @@
 
 #![allow(dead_code)]
 
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use polar_material::fresnel_cues::specular_dolp;
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::{Observation, StokesPlanes};
@@ -41,9 +41,9 @@ pub fn sphere_at(x: usize, y: usize) -> Option<(usize, f64, f64)> {
 }
 
 /// The observation of the two spheres (`surfaces[i]`) over a floor of S0 0.4.
-pub fn scene(surfaces: [Surface; 2]) -> (Observation, Image<f32, 3>, Gray<u8>) {
+pub fn scene(surfaces: [Surface; 2]) -> (Observation, NormalImage, Gray<u8>) {
     let mut p = StokesPlanes::new(W, H);
-    let mut normals = Image::<f32, 3>::new(W, H);
+    let mut normals = NormalImage::new(W, H);
     let mut fg = Gray::<u8>::new(W, H);
     for y in 0..H {
         for x in 0..W {

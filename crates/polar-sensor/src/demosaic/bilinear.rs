@@ -15,34 +15,35 @@
 //! interior and polanalyser returns zeros; there we replicate each super-pixel
 //! (nearest neighbour) instead.
 
-use polar_image::PolarizerStack;
+use polar_image::{ImageView, PolarizerStack};
 use rayon::prelude::*;
 
 use crate::layout::{Mosaic, MosaicSample, channel_at, offset_of};
 
-/// The four polarizer values at `(x, y)`, channel order `I0, I45, I90, I135`, in DN.
+/// The four polarizer values at `(x, y)` of the mosaic `raw`, channel order
+/// `I0, I45, I90, I135`, in DN.
 #[inline]
 pub(crate) fn bilinear_at<T: MosaicSample>(
-    src: &[T],
-    w: usize,
-    h: usize,
+    raw: ImageView<'_, T, 1>,
     x: usize,
     y: usize,
 ) -> [u32; 4] {
+    let (w, h) = raw.size();
     if w < 4 || h < 4 {
         let (bx, by) = (x & !1, y & !1);
         return std::array::from_fn(|c| {
             let (dx, dy) = offset_of(c);
-            src[(by + dy) * w + bx + dx].into()
+            raw.at(bx + dx, by + dy).into()
         });
     }
     let (x, y) = (x.clamp(1, w - 2), y.clamp(1, h - 2));
-    let at = |x: usize, y: usize| -> u32 { src[y * w + x].into() };
+    let [up, mid, dn] = [y - 1, y, y + 1].map(|r| raw.row(r));
+    let at = |row: &[T], x: usize| -> u32 { row[x].into() };
     let roles = [
-        at(x, y),
-        (at(x - 1, y) + at(x + 1, y) + 1) >> 1,
-        (at(x, y - 1) + at(x, y + 1) + 1) >> 1,
-        (at(x - 1, y - 1) + at(x + 1, y - 1) + at(x - 1, y + 1) + at(x + 1, y + 1) + 2) >> 2,
+        at(mid, x),
+        (at(mid, x - 1) + at(mid, x + 1) + 1) >> 1,
+        (at(up, x) + at(dn, x) + 1) >> 1,
+        (at(up, x - 1) + at(up, x + 1) + at(dn, x - 1) + at(dn, x + 1) + 2) >> 2,
     ];
     let mut out = [0; 4];
     for (r, (dx, dy)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
@@ -54,14 +55,14 @@ pub(crate) fn bilinear_at<T: MosaicSample>(
 /// Bilinear demosaicing of the whole mosaic (size already checked).
 pub(crate) fn bilinear<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
     let (w, h) = raw.size();
-    let src = raw.as_slice();
+    let src = raw.view();
     let mut out = PolarizerStack::new(w, h);
     out.pixels_mut()
         .par_chunks_mut(w)
         .enumerate()
         .for_each(|(y, row)| {
             for (x, px) in row.iter_mut().enumerate() {
-                *px = bilinear_at(src, w, h, x, y).map(|v| v as f32);
+                *px = bilinear_at(src, x, y).map(|v| v as f32);
             }
         });
     out
@@ -80,19 +81,17 @@ pub(crate) fn bilinear<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
 /// over the row with per-column selects, so that it vectorises; `#[inline(always)]`
 /// so that it is compiled for the SIMD target chosen by the caller's dispatch.
 ///
-/// Each output slice has the mosaic width; `w, h >= 4` (smaller frames use
+/// Each output slice has the mosaic width; width and height `>= 4` (smaller frames use
 /// [`bilinear_at`] per pixel).
 #[inline(always)]
 pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
-    src: &[T],
-    w: usize,
-    h: usize,
+    raw: ImageView<'_, T, 1>,
     y: usize,
     [s0, s1, s2]: [&mut [f32]; 3],
 ) {
+    let (w, h) = raw.size();
     let yc = y.clamp(1, h - 2);
-    let row = |r: usize| &src[r * w..(r + 1) * w];
-    let (up, mid, dn) = (row(yc - 1), row(yc), row(yc + 1));
+    let (up, mid, dn) = (raw.row(yc - 1), raw.row(yc), raw.row(yc + 1));
     let n = w - 2;
     // Every slice re-cut to exactly `n` so that the loop has no bounds checks.
     fn cut<T>(s: &[T], start: usize, n: usize) -> &[T] {
@@ -135,13 +134,14 @@ mod tests {
     #[test]
     fn fused_row_equals_stokes_of_demosaiced_pixels() {
         let (w, h) = (10, 8);
-        let src: Vec<u16> = (0..w * h).map(|i| ((i * 7919) % 4093) as u16).collect();
+        let data: Vec<u16> = (0..w * h).map(|i| ((i * 7919) % 4093) as u16).collect();
+        let raw = Mosaic::from_vec(w, h, data).unwrap();
         for y in 0..h {
             // Every parity of row and column is covered (all four super-pixel positions).
             let (mut a, mut b, mut c) = (vec![0.0; w], vec![0.0; w], vec![0.0; w]);
-            bilinear_stokes_row(&src, w, h, y, [&mut a, &mut b, &mut c]);
+            bilinear_stokes_row(raw.view(), y, [&mut a, &mut b, &mut c]);
             for x in 0..w {
-                let i = bilinear_at(&src, w, h, x, y).map(|v| v as f32);
+                let i = bilinear_at(raw.view(), x, y).map(|v| v as f32);
                 let want = linear_stokes_from_quad(i[0], i[1], i[2], i[3]);
                 // Bit for bit: also the sign of zero.
                 assert_eq!(

@@ -23,7 +23,7 @@
 //! and lowers the AoLP error; at edges where the *polarization* changes, the
 //! polarization-difference assumption fails and it is worse than bilinear.
 
-use polar_image::PolarizerStack;
+use polar_image::{Gray, PolarizerStack};
 use rayon::prelude::*;
 
 use super::bilinear::bilinear;
@@ -39,53 +39,39 @@ fn newton_1d(c: f32, m1: [f32; 2], c2: [f32; 2], m3: [f32; 2]) -> f32 {
     0.5 * c + 0.4375 * (m1[0] + m1[1]) - 0.25 * (c2[0] + c2[1]) + 0.0625 * (m3[0] + m3[1])
 }
 
-/// A full-resolution f32 plane with signed, bounds-free indexing helpers.
-struct Plane<'a> {
-    data: &'a [f32],
-    w: usize,
+/// A full-resolution f32 plane: the mosaic as floats or one of the estimates.
+type Plane = Gray<f32>;
+
+/// The sample of `p` at `(x + dx, y + dy)`, read as `Image::pixel` reads (one bounds
+/// check: this runs a few dozen times per pixel, always inside the plane).
+#[inline]
+fn at(p: &Plane, x: usize, y: usize, dx: isize, dy: isize) -> f32 {
+    p.pixel(x.wrapping_add_signed(dx), y.wrapping_add_signed(dy))[0]
 }
 
-impl Plane<'_> {
-    #[inline]
-    fn at(&self, x: usize, y: usize, dx: isize, dy: isize) -> f32 {
-        self.data[(y as isize + dy) as usize * self.w + (x as isize + dx) as usize]
-    }
+/// Samples of `p` at `(x ± k·dx, y ± k·dy)` as `[minus, plus]`.
+#[inline]
+fn pair(p: &Plane, x: usize, y: usize, dx: isize, dy: isize, k: isize) -> [f32; 2] {
+    [at(p, x, y, -k * dx, -k * dy), at(p, x, y, k * dx, k * dy)]
+}
 
-    /// Samples at `(x ± k·dx, y ± k·dy)` as `[minus, plus]`.
-    #[inline]
-    fn pair(&self, x: usize, y: usize, dx: isize, dy: isize, k: isize) -> [f32; 2] {
-        [
-            self.at(x, y, -k * dx, -k * dy),
-            self.at(x, y, k * dx, k * dy),
-        ]
-    }
-
-    /// Newton estimate along direction `(dx, dy)` of the channel that `m` holds at odd steps.
-    #[inline]
-    fn newton(
-        &self,
-        raw: &Plane<'_>,
-        m: &Plane<'_>,
-        x: usize,
-        y: usize,
-        dx: isize,
-        dy: isize,
-    ) -> f32 {
-        newton_1d(
-            raw.at(x, y, 0, 0),
-            m.pair(x, y, dx, dy, 1),
-            raw.pair(x, y, dx, dy, 2),
-            m.pair(x, y, dx, dy, 3),
-        )
-    }
+/// Newton estimate along direction `(dx, dy)` of the channel that `m` holds at odd steps.
+#[inline]
+fn newton_along(raw: &Plane, m: &Plane, x: usize, y: usize, dx: isize, dy: isize) -> f32 {
+    newton_1d(
+        at(raw, x, y, 0, 0),
+        pair(m, x, y, dx, dy, 1),
+        pair(raw, x, y, dx, dy, 2),
+        pair(m, x, y, dx, dy, 3),
+    )
 }
 
 /// Gradient along `(dx, dy)`: `|I₋₁ − I₊₁| + |2I − I₋₂ − I₊₂|` (the paper's edge strength).
 #[inline]
-fn gradient(raw: &Plane<'_>, x: usize, y: usize, dx: isize, dy: isize) -> f32 {
-    let [a, b] = raw.pair(x, y, dx, dy, 1);
-    let [c, d] = raw.pair(x, y, dx, dy, 2);
-    (a - b).abs() + (2.0 * raw.at(x, y, 0, 0) - c - d).abs()
+fn gradient(raw: &Plane, x: usize, y: usize, dx: isize, dy: isize) -> f32 {
+    let [a, b] = pair(raw, x, y, dx, dy, 1);
+    let [c, d] = pair(raw, x, y, dx, dy, 2);
+    (a - b).abs() + (2.0 * at(raw, x, y, 0, 0) - c - d).abs()
 }
 
 /// Fuses two directional estimates `e1` (along direction 1) and `e2` at `(x, y)`.
@@ -95,9 +81,9 @@ fn gradient(raw: &Plane<'_>, x: usize, y: usize, dx: isize, dy: isize) -> f32 {
 /// the estimates are weighted by inverse gradients `g1`, `g2`.
 #[allow(clippy::too_many_arguments)]
 fn fuse(
-    raw: &Plane<'_>,
-    e1: &Plane<'_>,
-    e2: &Plane<'_>,
+    raw: &Plane,
+    e1: &Plane,
+    e2: &Plane,
     x: usize,
     y: usize,
     margin: usize,
@@ -108,20 +94,20 @@ fn fuse(
         let (mut p1, mut p2) = (0.0, 0.0);
         for dy in [-2, 0, 2] {
             for dx in [-2, 0, 2] {
-                let c = raw.at(x, y, dx, dy);
-                p1 += (e1.at(x, y, dx, dy) - c).abs();
-                p2 += (e2.at(x, y, dx, dy) - c).abs();
+                let c = at(raw, x, y, dx, dy);
+                p1 += (at(e1, x, y, dx, dy) - c).abs();
+                p2 += (at(e2, x, y, dx, dy) - c).abs();
             }
         }
         if p1 > CLASSIFIER_RATIO * p2 {
-            return e2.at(x, y, 0, 0);
+            return at(e2, x, y, 0, 0);
         }
         if p2 > CLASSIFIER_RATIO * p1 {
-            return e1.at(x, y, 0, 0);
+            return at(e1, x, y, 0, 0);
         }
     }
     let (w1, w2) = (1.0 / (g1 + 1e-6), 1.0 / (g2 + 1e-6));
-    (w1 * e1.at(x, y, 0, 0) + w2 * e2.at(x, y, 0, 0)) / (w1 + w2)
+    (w1 * at(e1, x, y, 0, 0) + w2 * at(e2, x, y, 0, 0)) / (w1 + w2)
 }
 
 /// Fills a `w x h` plane in parallel from `f(x, y, margin)` at pixels with margin >= 3,
@@ -131,18 +117,21 @@ fn fill(
     h: usize,
     f: impl Fn(usize, usize, usize) -> f32 + Sync,
     fallback: impl Fn(usize, usize) -> f32 + Sync,
-) -> Vec<f32> {
-    let mut out = vec![0.0; w * h];
-    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, v) in row.iter_mut().enumerate() {
-            let margin = x.min(y).min(w - 1 - x).min(h - 1 - y);
-            *v = if margin >= 3 {
-                f(x, y, margin)
-            } else {
-                fallback(x, y)
-            };
-        }
-    });
+) -> Plane {
+    let mut out = Plane::new(w, h);
+    out.as_mut_slice()
+        .par_chunks_mut(w)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, v) in row.iter_mut().enumerate() {
+                let margin = x.min(y).min(w - 1 - x).min(h - 1 - y);
+                *v = if margin >= 3 {
+                    f(x, y, margin)
+                } else {
+                    fallback(x, y)
+                };
+            }
+        });
     out
 }
 
@@ -150,12 +139,16 @@ fn fill(
 pub(crate) fn newton<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
     let (w, h) = raw.size();
     let base = bilinear(raw);
-    let basep = base.pixels();
     // Bilinear value, at (x, y), of the channel found at offset (dx, dy).
     let base_of =
-        |x: usize, y: usize, dx: usize, dy: usize| basep[y * w + x][channel_at(x + dx, y + dy)];
-    let rawf: Vec<f32> = raw.as_slice().iter().map(|&v| v.into() as f32).collect();
-    let i = Plane { data: &rawf, w };
+        |x: usize, y: usize, dx: usize, dy: usize| base.pixel(x, y)[channel_at(x + dx, y + dy)];
+    let rawf = Plane::from_vec(
+        w,
+        h,
+        raw.as_slice().iter().map(|&v| v.into() as f32).collect(),
+    )
+    .expect("one value per sample");
+    let i = &rawf;
 
     // Step 1: first estimates along rows, columns and both diagonals.
     // Only read where margin >= 3, so the border of these planes is NaN (never used).
@@ -163,54 +156,43 @@ pub(crate) fn newton<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
         fill(
             w,
             h,
-            |x, y, _| i.newton(&i, &i, x, y, dx, dy),
+            |x, y, _| newton_along(i, i, x, y, dx, dy),
             |_, _| f32::NAN,
         )
     };
     let (hor1, ver1, diag1, diag2) = (along(1, 0), along(0, 1), along(1, 1), along(1, -1));
-    let (d1, d2) = (Plane { data: &diag1, w }, Plane { data: &diag2, w });
     let diag = fill(
         w,
         h,
         |x, y, m| {
-            fuse(
-                &i,
-                &d1,
-                &d2,
-                x,
-                y,
-                m,
-                gradient(&i, x, y, 1, 1),
-                gradient(&i, x, y, 1, -1),
-            )
+            let (g1, g2) = (gradient(i, x, y, 1, 1), gradient(i, x, y, 1, -1));
+            fuse(i, &diag1, &diag2, x, y, m, g1, g2)
         },
         |x, y| base_of(x, y, 1, 1),
     );
-    let d = Plane { data: &diag, w };
+    let d = &diag;
 
     // Step 2: horizontal-neighbour channel re-estimated vertically through the
     // diagonal estimates, and vice versa; fused with the step-1 estimates.
-    let (h1, v1) = (Plane { data: &hor1, w }, Plane { data: &ver1, w });
     let hor2 = fill(
         w,
         h,
-        |x, y, _| i.newton(&i, &d, x, y, 0, 1),
+        |x, y, _| newton_along(i, d, x, y, 0, 1),
         |_, _| f32::NAN,
     );
     let ver2 = fill(
         w,
         h,
-        |x, y, _| i.newton(&i, &d, x, y, 1, 0),
+        |x, y, _| newton_along(i, d, x, y, 1, 0),
         |_, _| f32::NAN,
     );
-    let (h2, v2) = (Plane { data: &hor2, w }, Plane { data: &ver2, w });
-    let grad_h_v = |x, y| (gradient(&i, x, y, 1, 0), gradient(&i, x, y, 0, 1));
+    let grad_h_v = |x, y| (gradient(i, x, y, 1, 0), gradient(i, x, y, 0, 1));
     let hor = fill(
         w,
         h,
         |x, y, m| {
             let (gh, gv) = grad_h_v(x, y);
-            fuse(&i, &h1, &h2, x, y, m, gh, gv)
+            fuse(i, &hor1, &hor2, x, y, m, gh, gv)
         },
         |x, y| base_of(x, y, 1, 0),
     );
@@ -219,25 +201,21 @@ pub(crate) fn newton<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
         h,
         |x, y, m| {
             let (gh, gv) = grad_h_v(x, y);
-            fuse(&i, &v1, &v2, x, y, m, gv, gh)
+            fuse(i, &ver1, &ver2, x, y, m, gv, gh)
         },
         |x, y| base_of(x, y, 0, 1),
     );
 
     let mut out = PolarizerStack::new(w, h);
+    let planes = [&rawf, &hor, &ver, &diag].map(|p| p.as_slice());
     out.pixels_mut()
         .par_chunks_mut(w)
         .enumerate()
         .for_each(|(y, row)| {
             for (x, px) in row.iter_mut().enumerate() {
                 let k = y * w + x;
-                for (v, (dx, dy)) in [
-                    (rawf[k], (0, 0)),
-                    (hor[k], (1, 0)),
-                    (ver[k], (0, 1)),
-                    (diag[k], (1, 1)),
-                ] {
-                    px[channel_at(x + dx, y + dy)] = v.max(0.0);
+                for (plane, (dx, dy)) in planes.iter().zip([(0, 0), (1, 0), (0, 1), (1, 1)]) {
+                    px[channel_at(x + dx, y + dy)] = plane[k].max(0.0);
                 }
             }
         });

@@ -27,7 +27,7 @@
 //! Measured (example `demosaic_error`): better than `bilinear` in every column
 //! (PSNR of each channel, DoLP and AoLP error) on edges, on fine texture and on both.
 
-use polar_image::{Border, PolarizerStack};
+use polar_image::{Border, Gray, ImageView, PolarizerStack};
 use polar_optics::stokes::linear_stokes_from_quad;
 use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
@@ -146,29 +146,30 @@ impl RowSink for StokesRow<'_> {
     }
 }
 
-/// The scaled guide `G` and the residual `raw − G` of a `w x h` mosaic (size checked,
-/// `src.len() == w * h`), written into `guide` and `res` (each `w * h`).
+/// The scaled guide `G` and the residual `raw − G` of a mosaic (size checked), written
+/// into `guide` and `res` (each of the mosaic's size).
 pub(crate) fn guide_and_residual<T: MosaicSample>(
-    src: &[T],
-    w: usize,
-    h: usize,
-    guide: &mut [f32],
-    res: &mut [f32],
+    raw: ImageView<'_, T, 1>,
+    guide: &mut Gray<f32>,
+    res: &mut Gray<f32>,
 ) {
-    guide.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        let rows = [mirror(y as isize - 1, h), y, mirror(y as isize + 1, h)]
-            .map(|r| &src[r * w..(r + 1) * w]);
+    let (w, h) = raw.size();
+    debug_assert!(guide.size() == (w, h) && res.size() == (w, h));
+    let guide_rows = guide.as_mut_slice().par_chunks_mut(w);
+    guide_rows.enumerate().for_each(|(y, row)| {
+        let rows = [mirror(y as isize - 1, h), y, mirror(y as isize + 1, h)].map(|r| raw.row(r));
         for (x, g) in row.iter_mut().enumerate() {
             *g = guide_at(|dx, dy| f(rows[(dy + 1) as usize][mirror(x as isize + dx, w)]));
         }
     });
-    let gains = pair_gains(guide, src, w, h);
+    let gains = pair_gains(guide.view(), raw);
     guide
+        .as_mut_slice()
         .par_chunks_mut(w)
-        .zip(res.par_chunks_mut(w))
+        .zip(res.as_mut_slice().par_chunks_mut(w))
         .enumerate()
         .for_each(|(y, (grow, rrow))| {
-            let srow = &src[y * w..(y + 1) * w];
+            let srow = raw.row(y);
             for (x, (g, r)) in grow.iter_mut().zip(rrow.iter_mut()).enumerate() {
                 *g *= gains[(x + y) & 1];
                 *r = f(srow[x]) - *g;
@@ -186,28 +187,32 @@ pub(crate) fn guide_and_residual<T: MosaicSample>(
 /// The pair sums `I0 + I90` and `I45 + I135` are both `S0` in theory, but on the
 /// bundled IMX250MZR frames the first is 2.0 % lower at every brightness; unbalanced,
 /// that would be a ±1 % checkerboard in S0.
-fn pair_gains<T: MosaicSample>(guide: &[f32], src: &[T], w: usize, h: usize) -> [f32; 2] {
-    let top = src.par_iter().map(|&v| f(v)).reduce(|| 0.0, f32::max);
+fn pair_gains<T: MosaicSample>(guide: ImageView<'_, f32, 1>, raw: ImageView<'_, T, 1>) -> [f32; 2] {
+    let (w, h) = raw.size();
+    let top = (0..h)
+        .into_par_iter()
+        .map(|y| raw.row(y).iter().map(|&v| f(v)).fold(0.0, f32::max))
+        .reduce(|| 0.0, f32::max);
     let (even, odd) = (2..h.saturating_sub(2))
         .into_par_iter()
         .map(|y| {
+            let near: [&[T]; 5] = std::array::from_fn(|k| raw.row(y + k - 2));
             let clipped = |x: usize| {
                 (-2..=2isize).any(|dy| {
                     (-2..=2isize).any(|dx| {
                         dx * dx + dy * dy < 8
-                            && f(src[y.wrapping_add_signed(dy) * w + x.wrapping_add_signed(dx)])
-                                >= top
+                            && f(near[(dy + 2) as usize][x.wrapping_add_signed(dx)]) >= top
                     })
                 })
             };
+            let [up, mid, down] = [y - 1, y, y + 1].map(|r| guide.row(r));
             let (mut e, mut o) = (0.0f64, 0.0f64);
             for x in (2 + (y & 1)..w.saturating_sub(2)).step_by(2) {
                 if clipped(x) {
                     continue;
                 }
-                let k = y * w + x;
-                e += f64::from(guide[k]);
-                o += 0.25 * f64::from(guide[k - 1] + guide[k + 1] + guide[k - w] + guide[k + w]);
+                e += f64::from(mid[x]);
+                o += 0.25 * f64::from(mid[x - 1] + mid[x + 1] + up[x] + down[x]);
             }
             (e, o)
         })
@@ -220,16 +225,15 @@ fn pair_gains<T: MosaicSample>(guide: &[f32], src: &[T], w: usize, h: usize) -> 
     }
 }
 
-/// One output row `y` of the residual interpolation into `sink` (the row's length `w`),
-/// from the mosaic, the scaled guide and the residual of [`guide_and_residual`], as a
-/// `pulp` operation: `with_simd` is compiled per SIMD target. The interior columns run
-/// in one uniform loop over pre-cut slices; the three columns at each border mirror.
+/// One output row `y` of the residual interpolation into `sink` (the row's length),
+/// from the mosaic `raw`, the scaled guide and the residual of [`guide_and_residual`]
+/// (all of one size), as a `pulp` operation: `with_simd` is compiled per SIMD target.
+/// The interior columns run in one uniform loop over pre-cut slices; the three columns
+/// at each border mirror.
 pub(crate) struct ResidualRow<'a, T, S> {
-    pub src: &'a [T],
-    pub guide: &'a [f32],
-    pub res: &'a [f32],
-    pub w: usize,
-    pub h: usize,
+    pub raw: ImageView<'a, T, 1>,
+    pub guide: ImageView<'a, f32, 1>,
+    pub res: ImageView<'a, f32, 1>,
     pub y: usize,
     pub sink: S,
 }
@@ -250,17 +254,13 @@ impl<T: MosaicSample, S: RowSink> WithSimd for ResidualRow<'_, T, S> {
 impl<T: MosaicSample, S: RowSink> ResidualRow<'_, T, S> {
     #[inline(always)]
     fn run<const ODD_ROW: bool>(mut self) {
-        let (w, h, y) = (self.w, self.h, self.y);
-        let row_of = |dy: isize| mirror(y as isize + dy, h) * w;
-        let raw: [&[T]; 2 * PAD + 1] = std::array::from_fn(|k| {
-            let r = row_of(k as isize - PAD as isize);
-            &self.src[r..r + w]
-        });
-        let res: [&[f32]; 3] = std::array::from_fn(|k| {
-            let r = row_of(k as isize - 1);
-            &self.res[r..r + w]
-        });
-        let guide = &self.guide[y * w..(y + 1) * w];
+        let ((w, h), y) = (self.raw.size(), self.y);
+        debug_assert!(self.guide.size() == (w, h) && self.res.size() == (w, h));
+        let row_of = |dy: isize| mirror(y as isize + dy, h);
+        let raw: [&[T]; 2 * PAD + 1] =
+            std::array::from_fn(|k| self.raw.row(row_of(k as isize - PAD as isize)));
+        let res: [&[f32]; 3] = std::array::from_fn(|k| self.res.row(row_of(k as isize - 1)));
+        let guide = self.guide.row(y);
         let n = w.saturating_sub(2 * PAD);
         // Border columns, mirrored.
         let (left, right) = if n == 0 {
@@ -303,9 +303,9 @@ impl<T: MosaicSample, S: RowSink> ResidualRow<'_, T, S> {
 /// (size already checked).
 pub(crate) fn residual<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
     let (w, h) = raw.size();
-    let src = raw.as_slice();
-    let (mut guide, mut res) = (vec![0.0; w * h], vec![0.0; w * h]);
-    guide_and_residual(src, w, h, &mut guide, &mut res);
+    let (mut guide, mut res) = (Gray::new(w, h), Gray::new(w, h));
+    guide_and_residual(raw.view(), &mut guide, &mut res);
+    let (raw, guide, res) = (raw.view(), guide.view(), res.view());
     let mut out = PolarizerStack::new(w, h);
     let arch = Arch::new();
     out.pixels_mut()
@@ -313,11 +313,9 @@ pub(crate) fn residual<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
         .enumerate()
         .for_each(|(y, row)| {
             arch.dispatch(ResidualRow {
-                src,
-                guide: &guide,
-                res: &res,
-                w,
-                h,
+                raw,
+                guide,
+                res,
                 y,
                 sink: row,
             })
@@ -688,17 +686,14 @@ mod tests {
                 assert!(eq, "{name} fused planes");
             }
             for arch in simd_targets() {
-                let (mut guide, mut res) = (vec![0.0; w * h], vec![0.0; w * h]);
-                let src = raw16.as_slice();
-                guide_and_residual(src, w, h, &mut guide, &mut res);
+                let (mut guide, mut res) = (Gray::new(w, h), Gray::new(w, h));
+                guide_and_residual(raw16.view(), &mut guide, &mut res);
                 let mut out = PolarizerStack::new(w, h);
                 for (y, row) in out.pixels_mut().chunks_mut(w).enumerate() {
                     arch.dispatch(ResidualRow {
-                        src,
-                        guide: &guide,
-                        res: &res,
-                        w,
-                        h,
+                        raw: raw16.view(),
+                        guide: guide.view(),
+                        res: res.view(),
                         y,
                         sink: row,
                     });

@@ -10,7 +10,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
-use polar_image::{Gray, Image};
+use polar_image::{Gray, NormalImage};
 use polar_io::GroundTruth;
 use polar_sensor::Observation;
 use serde_json::Value;
@@ -63,7 +63,7 @@ pub struct Context<'a> {
     /// Ground-truth radiance per unit of the observation's S0, where known (see `run`).
     pub radiance_per_unit: Option<f64>,
     /// Normals from `sfp`, for `material`.
-    pub normals: Option<Image<f32, 3>>,
+    pub normals: Option<NormalImage>,
     /// Transparency mask from `transparent`, for `material`.
     pub transparent: Option<Gray<u8>>,
 }
