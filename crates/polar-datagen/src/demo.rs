@@ -226,8 +226,9 @@ pub fn render_into(
     let name = sample_name(out)?;
     let staged = StagedDir::new(out, files::META)?;
     let result = render(scene, &name)?;
-    write_sample(staged.path(), scene, &result, noise, record, &name)?;
+    let model = result.model;
     write_pictures(&staged.path().join(files::vision::PICTURES), &result.stokes)?;
+    write_sample(staged.path(), scene, result, noise, record, &name)?;
     staged.commit()?;
-    Ok(result.model)
+    Ok(model)
 }

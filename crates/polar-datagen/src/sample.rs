@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use polar_image::{Gray, Image, StokesImage};
-use polar_io::files;
-use polar_render::{FirstHit, Polarization, RenderOptions, RenderOutput, Scene};
+use polar_io::{BitDepth, MosaicPng};
+use polar_render::{Polarization, RenderOptions, RenderOutput, Scene};
 use polar_sensor::SensorModel;
 use serde::Serialize;
 
@@ -32,11 +32,12 @@ impl SampleWorker for RenderWorker {
             id: params.id.clone(),
             message: format!("parameters to JSON: {e}"),
         })?;
-        write_sample(dir, &scene, &out, &params.noise, &record, &params.id)?;
-        Ok(WorkReport {
+        let report = WorkReport {
             model: out.model,
             render_seconds: out.seconds,
-        })
+        };
+        write_sample(dir, &scene, out, &params.noise, &record, &params.id)?;
+        Ok(report)
     }
 }
 
@@ -135,81 +136,57 @@ fn io_err(id: &str) -> impl Fn(polar_io::Error) -> Error + '_ {
 
 /// Writes meta.json, raw.png, stokes.exr, polarizers.exr (the noiseless full-resolution
 /// images behind the four micro-polarizers) and gt/ (with clear.exr, transmission.exr and
-/// dehazed.exr when the scene has a medium) for one render into `dir`.
-/// `scene_meta` is recorded verbatim as `meta.scene` (the sample parameters or the scene file).
-/// The sensor noise is seeded from the scene's render seed.
+/// dehazed.exr when the scene has a medium) for one render into `dir`, through
+/// [`polar_io::write_sample_into`]. `scene_meta` is recorded verbatim as `meta.scene` (the
+/// sample parameters or the scene file). The sensor noise is seeded from the scene's render seed.
 pub fn write_sample(
     dir: &Path,
     scene: &Scene,
-    out: &RenderOutput,
+    out: RenderOutput,
     noise: &NoiseLevel,
     scene_meta: &serde_json::Value,
     id: &str,
 ) -> Result<(), Error> {
-    let model = sensor_model(noise, &out.stokes, scene.settings.seed);
-    let exposed = model.expose(&out.stokes).map_err(|e| Error::Sample {
+    let sample_err = |message: String| Error::Sample {
         id: id.to_owned(),
-        message: e.to_string(),
-    })?;
-    polar_io::write_gray16_png(dir.join(files::RAW), &exposed.raw).map_err(io_err(id))?;
-    polar_io::write_exr(
-        dir.join(files::STOKES),
-        &out.stokes,
-        polar_io::STOKES_CHANNELS,
-    )
-    .map_err(io_err(id))?;
+        message,
+    };
+    if out.ground_truth.is_none() {
+        return Err(sample_err("rendered without ground truth".into()));
+    }
+    let model = sensor_model(noise, &out.stokes, scene.settings.seed);
+    let exposed = model
+        .expose(&out.stokes)
+        .map_err(|e| sample_err(e.to_string()))?;
     let polarizers = model
         .polarizer_images(&out.stokes)
-        .map_err(|e| Error::Sample {
-            id: id.to_owned(),
-            message: e.to_string(),
-        })?;
-    polar_io::write_exr(
-        dir.join(files::POLARIZERS),
-        &polarizers,
-        polar_io::POLARIZER_CHANNELS,
-    )
-    .map_err(io_err(id))?;
-    let truth = out.ground_truth.as_ref().ok_or_else(|| Error::Sample {
-        id: id.to_owned(),
-        message: "rendered without ground truth".into(),
-    })?;
-    let gt = dir.join(files::GT_DIR);
-    std::fs::create_dir_all(&gt).map_err(Error::io(&gt))?;
-    write_ground_truth(dir, truth, out).map_err(io_err(id))?;
+        .map_err(|e| sample_err(e.to_string()))?;
     let meta = meta(
         scene,
-        out,
+        &out,
         noise,
         &model,
         exposed.saturated_count,
         scene_meta,
     );
-    Ok(polar_io::write_json(dir.join(files::META), &meta)?)
-}
-
-/// Writes the files of `gt/` (which exists): the first-hit images of `truth` and, where rendered (a medium), the
-/// medium-free view, the transmittance and the view with the medium off the camera rays
-/// only, for dehazing.
-fn write_ground_truth(dir: &Path, truth: &FirstHit, out: &RenderOutput) -> polar_io::Result<()> {
-    polar_io::write_exr(
-        dir.join(files::GT_NORMAL),
-        &truth.normal,
-        polar_io::RGB_CHANNELS,
-    )?;
-    polar_io::write_exr(dir.join(files::GT_DEPTH), &truth.depth, polar_io::Y_CHANNEL)?;
-    polar_io::write_gray8_png(dir.join(files::GT_MATERIAL), &truth.material)?;
-    polar_io::write_gray8_png(dir.join(files::GT_TRANSPARENT), &truth.transparent)?;
-    for (name, image) in [
-        (files::GT_CLEAR, &out.clear),
-        (files::GT_TRANSMISSION, &truth.transmission),
-        (files::GT_DEHAZED, &out.dehazed),
-    ] {
-        if let Some(image) = image {
-            polar_io::write_exr(dir.join(name), image, polar_io::Y_CHANNEL)?;
+    let meta = match serde_json::to_value(meta) {
+        Ok(serde_json::Value::Object(map)) => map,
+        other => {
+            return Err(sample_err(format!(
+                "meta.json is not a JSON object: {other:?}"
+            )));
         }
-    }
-    Ok(())
+    };
+    let sample = polar_io::Sample {
+        meta,
+        raw: Some(MosaicPng {
+            image: exposed.raw,
+            bit_depth: BitDepth::Sixteen,
+        }),
+        polarizers: Some(polarizers),
+        ..out.into_sample()
+    };
+    polar_io::write_sample_into(dir, &sample).map_err(io_err(id))
 }
 
 fn meta<'a>(

@@ -31,7 +31,7 @@ pub use png::{
 pub use sample::{
     GroundTruth, MaterialLabel, Sample, TRANSPARENT_MASK_ON, files, parse_json, parse_meta,
     read_ground_truth, read_json, read_optional_meta, read_sample, read_sample_with, write_json,
-    write_sample,
+    write_sample, write_sample_into,
 };
 pub use shard::{Shard, ShardError};
 pub use staged::{StagedDir, check_replaceable};

@@ -1,11 +1,11 @@
 //! The sample directory of `conventions.md`: `meta.json` (required) plus optional `raw.png`,
-//! `stokes.exr` and `gt/{normal,depth,clear,transmission,dehazed}.exr`, `gt/{material,transparent}.png`.
+//! `stokes.exr`, `polarizers.exr` and `gt/{normal,depth,clear,transmission,dehazed}.exr`, `gt/{material,transparent}.png`.
 //! Reading checks every file against the format's rules and that all images share one size;
 //! writing checks the same, then writes the whole directory atomically.
 
 use std::path::{Path, PathBuf};
 
-use polar_image::{Gray, Image, NormalImage, StokesImage};
+use polar_image::{Gray, Image, NormalImage, PolarizerStack, StokesImage};
 use serde_json::{Map, Value};
 
 use crate::atomic::write_atomic;
@@ -15,7 +15,7 @@ use crate::png::{
 };
 use crate::staged::StagedDir;
 use crate::validate::{Rule, Validation, check_channels, check_stokes, check_u8};
-use crate::{RGB_CHANNELS, STOKES_CHANNELS, Y_CHANNEL, read_exr, write_exr};
+use crate::{POLARIZER_CHANNELS, RGB_CHANNELS, STOKES_CHANNELS, Y_CHANNEL, read_exr, write_exr};
 
 /// File names inside a sample directory, relative to it.
 pub mod files {
@@ -190,6 +190,8 @@ pub struct Sample {
     pub raw: Option<MosaicPng>,
     /// `stokes.exr`.
     pub stokes: Option<StokesImage>,
+    /// `polarizers.exr`.
+    pub polarizers: Option<PolarizerStack>,
     /// `gt/`.
     pub gt: GroundTruth,
 }
@@ -201,7 +203,7 @@ pub fn read_sample(dir: impl AsRef<Path>) -> Result<Sample> {
 
 /// Reads a sample directory. `meta.json` must exist and hold a JSON object; every other file
 /// is read if present. With [`Validation::Check`]: S0 finite and `>= 0`, S1..S3, normals,
-/// depth, clear and dehazed S0 finite (and `>= 0`), transmission in `[0, 1]`,
+/// polarizer intensities (finite, `>= 0`), depth, clear and dehazed S0 finite (and `>= 0`), transmission in `[0, 1]`,
 /// material labels in 0..=3, the transparency mask 0 or 255. Mosaic size and equal sizes across files are always checked.
 pub fn read_sample_with(dir: impl AsRef<Path>, validation: Validation) -> Result<Sample> {
     let dir = dir.as_ref();
@@ -217,6 +219,9 @@ pub fn read_sample_with(dir: impl AsRef<Path>, validation: Validation) -> Result
         raw: opt(files::RAW)?.map(read_mosaic).transpose()?,
         stokes: opt(files::STOKES)?
             .map(|p| read_exr(p, STOKES_CHANNELS))
+            .transpose()?,
+        polarizers: opt(files::POLARIZERS)?
+            .map(|p| read_exr(p, POLARIZER_CHANNELS))
             .transpose()?,
         gt: read_gt_files(dir)?,
     };
@@ -277,6 +282,15 @@ pub fn write_sample(dir: impl AsRef<Path>, sample: &Sample) -> Result<()> {
     let staged = StagedDir::new(dir, files::META)?;
     write_sample_files(staged.path(), sample)?;
     staged.commit().map(drop)
+}
+
+/// Writes `sample` into the existing directory `dir` after the checks of [`write_sample`],
+/// not atomically: for a caller that stages the directory itself (a dataset's
+/// [`StagedDir::within`]) and may add files of its own.
+pub fn write_sample_into(dir: impl AsRef<Path>, sample: &Sample) -> Result<()> {
+    let dir = dir.as_ref();
+    check_sample(dir, sample, Validation::Check)?;
+    write_sample_files(dir, sample)
 }
 
 /// Writes any serializable value as pretty JSON (e.g. `metrics.json`), atomically.
@@ -350,6 +364,7 @@ fn check_sample(dir: &Path, s: &Sample, validation: Validation) -> Result<()> {
     }
     let other_files = [
         (files::STOKES, s.stokes.as_ref().map(Image::size)),
+        (files::POLARIZERS, s.polarizers.as_ref().map(Image::size)),
         (files::GT_NORMAL, gt.normal.as_ref().map(Image::size)),
         (files::GT_DEPTH, gt.depth.as_ref().map(Image::size)),
         (files::GT_MATERIAL, gt.material.as_ref().map(Image::size)),
@@ -380,6 +395,14 @@ fn check_values(dir: &Path, s: &Sample) -> Result<()> {
     let gt = &s.gt;
     if let Some(stokes) = &s.stokes {
         check_stokes(&dir.join(files::STOKES), stokes)?;
+    }
+    if let Some(polarizers) = &s.polarizers {
+        check_channels(
+            &dir.join(files::POLARIZERS),
+            polarizers,
+            POLARIZER_CHANNELS,
+            [FiniteNonNegative; 4],
+        )?;
     }
     if let Some(normal) = &gt.normal {
         check_channels(
@@ -446,7 +469,7 @@ fn write_sample_files(dir: &Path, s: &Sample) -> Result<()> {
         || gt.transmission.is_some()
         || gt.dehazed.is_some();
     if has_gt {
-        let gt = dir.join("gt");
+        let gt = dir.join(files::GT_DIR);
         std::fs::create_dir(&gt).map_err(|e| Error::io(&gt, "directory", e))?;
     }
     write_json(dir.join(files::META), &s.meta)?;
@@ -456,6 +479,9 @@ fn write_sample_files(dir: &Path, s: &Sample) -> Result<()> {
     }
     if let Some(stokes) = &s.stokes {
         write_exr(p(files::STOKES), stokes, STOKES_CHANNELS)?;
+    }
+    if let Some(polarizers) = &s.polarizers {
+        write_exr(p(files::POLARIZERS), polarizers, POLARIZER_CHANNELS)?;
     }
     if let Some(normal) = &gt.normal {
         write_exr(p(files::GT_NORMAL), normal, RGB_CHANNELS)?;

@@ -2,11 +2,11 @@
 
 use std::path::Path;
 
-use polar_image::{Gray, Image, Mosaic, StokesImage};
+use polar_image::{Gray, Image, Mosaic, PolarizerStack, StokesImage};
 use polar_io::{
     BitDepth, Error, GroundTruth, MaterialLabel, MosaicPng, STOKES_CHANNELS, Sample, Validation,
     files, read_json, read_sample, read_sample_with, write_exr, write_gray8_png, write_gray16_png,
-    write_json, write_sample,
+    write_json, write_sample, write_sample_into,
 };
 use serde_json::{Map, Value, json};
 
@@ -33,6 +33,13 @@ fn raw16() -> MosaicPng {
     }
 }
 
+fn polarizers() -> PolarizerStack {
+    let data = (0..W * H)
+        .flat_map(|i| [0.5 + i as f32, 0.25, 0.0, 0.125])
+        .collect();
+    Image::from_vec(W, H, data).unwrap()
+}
+
 fn full_sample() -> Sample {
     let labels = (0..W * H).map(|i| (i % 4) as u8).collect();
     let mask = (0..W * H)
@@ -42,6 +49,7 @@ fn full_sample() -> Sample {
         meta: meta(),
         raw: Some(raw16()),
         stokes: Some(stokes()),
+        polarizers: Some(polarizers()),
         gt: GroundTruth {
             normal: Some(Image::from_vec(W, H, [0.0, 0.6, 0.8].repeat(W * H)).unwrap()),
             depth: Some(Gray::from_vec(W, H, vec![2.5; W * H]).unwrap()),
@@ -70,6 +78,7 @@ fn full_sample_round_trip_is_exact() {
         files::META,
         files::RAW,
         files::STOKES,
+        files::POLARIZERS,
         files::GT_NORMAL,
         files::GT_CLEAR,
         files::GT_TRANSMISSION,
@@ -241,6 +250,8 @@ fn invalid_ground_truth_values_are_refused_on_write() {
     // Transmittance above 1 (and NaN) is not a transmittance.
     let mut over_one = full_sample();
     over_one.gt.transmission.as_mut().unwrap().as_mut_slice()[2] = 1.01;
+    let mut neg_polarizer = full_sample();
+    neg_polarizer.polarizers.as_mut().unwrap().as_mut_slice()[5] = -0.25;
     let mut nan_transmission = full_sample();
     nan_transmission
         .gt
@@ -250,6 +261,7 @@ fn invalid_ground_truth_values_are_refused_on_write() {
         .as_mut_slice()[0] = f32::NAN;
     for (s, file) in [
         (over_one, files::GT_TRANSMISSION),
+        (neg_polarizer, files::POLARIZERS),
         (nan_transmission, files::GT_TRANSMISSION),
         (inf_normal, files::GT_NORMAL),
         (bad_label, files::GT_MATERIAL),
@@ -279,6 +291,27 @@ fn rewriting_a_sample_replaces_it_whole() {
     assert_eq!(read_sample(&dir).unwrap(), only_raw);
     assert!(!dir.join("gt").exists() && !dir.join(files::STOKES).exists());
     assert_eq!(std::fs::read_dir(root.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn write_sample_into_fills_a_staged_folder_and_keeps_its_other_files() {
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path().join("staged");
+    std::fs::create_dir(&dir).unwrap();
+    std::fs::write(dir.join("extra.txt"), b"kept").unwrap();
+    write_sample_into(&dir, &full_sample()).unwrap();
+    assert_eq!(read_sample(&dir).unwrap(), full_sample());
+    assert_eq!(std::fs::read(dir.join("extra.txt")).unwrap(), b"kept");
+    // The checks come first: a bad sample writes nothing.
+    let fresh = root.path().join("fresh");
+    std::fs::create_dir(&fresh).unwrap();
+    let mut bad = full_sample();
+    bad.stokes.as_mut().unwrap().as_mut_slice()[0] = f32::NAN;
+    assert!(matches!(
+        write_sample_into(&fresh, &bad),
+        Err(Error::InvalidValue { .. })
+    ));
+    assert_eq!(std::fs::read_dir(&fresh).unwrap().count(), 0);
 }
 
 #[test]

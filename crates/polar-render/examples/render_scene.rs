@@ -4,9 +4,8 @@
 //!
 //! `cargo run --release -p polar-render --example render_scene -- SCENE OUT_DIR [--spp N] [--model none|linear|full] [--sampler sobol|independent] [--gt]`
 
-use polar_io::files;
-use polar_render::{Polarization, RenderOptions, RenderOutput, SamplerKind, load_scene, render};
-use std::path::{Path, PathBuf};
+use polar_render::{Polarization, RenderOptions, SamplerKind, load_scene, render};
+use std::path::PathBuf;
 
 fn main() {
     if let Err(e) = run() {
@@ -64,56 +63,26 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         },
     )?;
     eprintln!();
-    std::fs::create_dir_all(&out)?;
-    polar_io::write_exr(
-        out.join(files::STOKES),
-        &out_img.stokes,
-        polar_io::STOKES_CHANNELS,
-    )?;
-    if gt {
-        write_ground_truth(&out, &out_img)?;
-    }
-    let meta = serde_json::json!({
-        "width": scene.camera.width,
-        "height": scene.camera.height,
-        "scene": scene_path.display().to_string(),
-        "renderer": "polar-render",
-        "model": format!("{:?}", out_img.model),
-        "spp": out_img.spp,
-        "sampler": format!("{:?}", scene.settings.sampler),
-        "seconds": out_img.seconds,
-    });
-    std::fs::write(out.join(files::META), serde_json::to_string_pretty(&meta)?)?;
     eprintln!(
         "{:?} transport, {} spp, {:.3} s",
         out_img.model, out_img.spp, out_img.seconds
     );
-    Ok(())
-}
-
-/// Writes the ground truth of `img` (rendered with it) under `out/gt/`.
-fn write_ground_truth(out: &Path, img: &RenderOutput) -> Result<(), Box<dyn std::error::Error>> {
-    let truth = img
-        .ground_truth
-        .as_ref()
-        .ok_or("rendered without ground truth")?;
-    std::fs::create_dir_all(out.join(files::GT_DIR))?;
-    polar_io::write_exr(
-        out.join(files::GT_NORMAL),
-        &truth.normal,
-        polar_io::RGB_CHANNELS,
-    )?;
-    polar_io::write_exr(out.join(files::GT_DEPTH), &truth.depth, polar_io::Y_CHANNEL)?;
-    polar_io::write_gray8_png(out.join(files::GT_MATERIAL), &truth.material)?;
-    polar_io::write_gray8_png(out.join(files::GT_TRANSPARENT), &truth.transparent)?;
-    for (name, image) in [
-        (files::GT_CLEAR, &img.clear),
-        (files::GT_TRANSMISSION, &truth.transmission),
-        (files::GT_DEHAZED, &img.dehazed),
-    ] {
-        if let Some(image) = image {
-            polar_io::write_exr(out.join(name), image, polar_io::Y_CHANNEL)?;
-        }
-    }
+    let serde_json::Value::Object(meta) = serde_json::json!({
+        "width": scene.camera.width,
+        "height": scene.camera.height,
+        "scene": scene_path.display().to_string(),
+        "renderer": "polar-render",
+        "model": out_img.model,
+        "spp": out_img.spp,
+        "sampler": scene.settings.sampler,
+        "seconds": out_img.seconds,
+    }) else {
+        return Err("meta is not a JSON object".into());
+    };
+    let sample = polar_io::Sample {
+        meta,
+        ..out_img.into_sample()
+    };
+    polar_io::write_sample(&out, &sample)?;
     Ok(())
 }

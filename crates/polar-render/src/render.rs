@@ -9,7 +9,7 @@ use crate::transport::{Full, Linear, Scalar, Transport};
 use crate::world::World;
 use polar_bsdf::Material;
 use polar_image::{Gray, NormalImage, StokesImage};
-use polar_io::{MaterialLabel, TRANSPARENT_MASK_ON};
+use polar_io::{GroundTruth, MaterialLabel, Sample, TRANSPARENT_MASK_ON};
 use polar_optics::{Polarization, Stokes};
 use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
@@ -62,6 +62,35 @@ pub struct RenderOutput {
     pub seconds: f64,
     /// Samples per pixel.
     pub spp: u32,
+}
+
+impl RenderOutput {
+    /// The render as the files of a sample directory (`conventions.md`): `stokes.exr` and
+    /// whatever of `gt/` was rendered; the caller adds `meta.json` and any sensor files.
+    pub fn into_sample(self) -> Sample {
+        let (hit, clear, dehazed) = (self.ground_truth, self.clear, self.dehazed);
+        let gt = match hit {
+            Some(h) => GroundTruth {
+                normal: Some(h.normal),
+                depth: Some(h.depth),
+                material: Some(h.material),
+                transparent: Some(h.transparent),
+                clear,
+                transmission: h.transmission,
+                dehazed,
+            },
+            None => GroundTruth {
+                clear,
+                dehazed,
+                ..GroundTruth::default()
+            },
+        };
+        Sample {
+            stokes: Some(self.stokes),
+            gt,
+            ..Sample::default()
+        }
+    }
 }
 
 /// Ground truth of the first hit along each pixel's central ray: the `gt/` images of

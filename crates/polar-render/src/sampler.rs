@@ -20,7 +20,7 @@
 use serde::Deserialize;
 
 /// Where the aligned draws come from (`[render] sampler` in a scene file).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SamplerKind {
     /// Owen-scrambled Sobol points (Burley 2020, "Practical Hash-based Owen
