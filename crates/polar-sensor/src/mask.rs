@@ -45,12 +45,13 @@ fn saturated_support<T: MosaicSample>(
 ) -> Gray<bool> {
     let (w, h) = raw.size();
     let src = raw.as_slice();
-    let hit = |i: usize| src[i].into() >= saturation;
     if method == DemosaicMethod::Superpixel {
         let data = (0..(w / 2) * (h / 2))
             .map(|k| {
                 let (x, y) = (2 * (k % (w / 2)), 2 * (k / (w / 2)));
-                [0, 1, w, w + 1].iter().any(|&d| hit(y * w + x + d))
+                [0, 1, w, w + 1]
+                    .iter()
+                    .any(|&d| src[y * w + x + d].into() >= saturation)
             })
             .collect();
         return Gray::from_vec(w / 2, h / 2, data).expect("size matches");
@@ -58,22 +59,47 @@ fn saturated_support<T: MosaicSample>(
     // Separable dilation of the saturated samples by a (2r+1) square, centred on
     // the clamped pixel because border pixels copy their inner neighbour (bilinear).
     let r = method.support_radius();
-    let centre = |v: usize, n: usize| if n >= 4 { v.clamp(1, n - 2) } else { v };
-    let rows: Vec<bool> = (0..w * h)
-        .into_par_iter()
-        .map(|k| {
-            let (x, y) = (centre(k % w, w), k / w);
-            (x.saturating_sub(r)..(x + r + 1).min(w)).any(|xx| hit(y * w + xx))
-        })
-        .collect();
-    let data = (0..w * h)
-        .into_par_iter()
-        .map(|k| {
-            let (x, y) = (k % w, centre(k / w, h));
-            (y.saturating_sub(r)..(y + r + 1).min(h)).any(|yy| rows[yy * w + x])
-        })
-        .collect();
+    let mut rows = vec![false; w * h];
+    rows.par_chunks_mut(w.max(1))
+        .zip(src.par_chunks(w.max(1)))
+        .for_each(|(out, row)| dilate_row(row, saturation, r, out));
+    let mut data = vec![false; w * h];
+    data.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(y, out)| {
+            let cy = centre(y, h);
+            for yy in cy.saturating_sub(r)..(cy + r + 1).min(h) {
+                out.iter_mut()
+                    .zip(&rows[yy * w..][..w])
+                    .for_each(|(o, &s)| *o |= s);
+            }
+        });
     Gray::from_vec(w, h, data).expect("size matches")
+}
+
+/// The output pixel whose support is centred on `v` of `0..n`: border pixels copy their
+/// inner neighbour (bilinear), so their support is the neighbour's.
+fn centre(v: usize, n: usize) -> usize {
+    if n >= 4 { v.clamp(1, n - 2) } else { v }
+}
+
+/// `out[x]`: whether `row` holds a sample `>= saturation` within `r` of `centre(x)`,
+/// from a running count of the hits (one pass, no per-pixel window scan).
+fn dilate_row<T: MosaicSample>(row: &[T], saturation: u32, r: usize, out: &mut [bool]) {
+    let w = row.len();
+    let mut count = Vec::with_capacity(w + 1);
+    count.push(0u32);
+    for &v in row {
+        let hits = count[count.len() - 1] + u32::from(v.into() >= saturation);
+        count.push(hits);
+    }
+    if count[w] == 0 {
+        return;
+    }
+    for (x, o) in out.iter_mut().enumerate() {
+        let c = centre(x, w);
+        *o = count[(c + r + 1).min(w)] > count[c.saturating_sub(r)];
+    }
 }
 
 /// Number of raw samples at or above `saturation`.
@@ -103,6 +129,53 @@ mod tests {
                     if near { SATURATED } else { 0 },
                     "({x},{y})"
                 );
+            }
+        }
+    }
+
+    /// The definition, pixel by pixel: a raw sample `>= saturation` in the (2r+1) square
+    /// around the clamped centre.
+    fn brute_force(raw: &Mosaic<u16>, saturation: u32, r: usize) -> Vec<bool> {
+        let (w, h) = raw.size();
+        let mut out = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let (cx, cy) = (centre(x, w), centre(y, h));
+                let xs = cx.saturating_sub(r)..(cx + r + 1).min(w);
+                let ys = cy.saturating_sub(r)..(cy + r + 1).min(h);
+                out.push(ys.into_iter().any(|yy| {
+                    xs.clone()
+                        .any(|xx| u32::from(raw.pixel(xx, yy)[0]) >= saturation)
+                }));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn saturated_support_matches_its_definition_on_random_frames() {
+        let mut state = 0x9e37_79b9_u32;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state
+        };
+        for (w, h) in [(2, 2), (4, 2), (2, 6), (6, 4), (10, 8), (34, 12)] {
+            for density in [1, 8, 64] {
+                let data = (0..w * h)
+                    .map(|_| if next() % 256 < density { 4095 } else { 7 })
+                    .collect();
+                let raw = Mosaic::<u16>::from_vec(w, h, data).unwrap();
+                for method in [DemosaicMethod::Bilinear, DemosaicMethod::Residual] {
+                    let fast = saturated_support(&raw, 4095, method);
+                    let r = method.support_radius();
+                    assert_eq!(
+                        fast.as_slice(),
+                        brute_force(&raw, 4095, r),
+                        "{w}x{h}, density {density}/256, {method:?}"
+                    );
+                }
             }
         }
     }
