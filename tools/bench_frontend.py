@@ -18,7 +18,7 @@ Whole process (`--process N`): `polar-vision stokes FRAME --out DIR` spawned as 
 runs it (release build), median of N runs, with the default `residual` and with
 `--demosaic bilinear`, in the same run as polanalyser's chain; reports the split the
 program prints (compute = read + demosaic + products, outputs), the bytes its outputs
-take on disk and its peak resident memory per input pixel (from wait4's ru_maxrss).
+take on disk and its peak resident memory per input pixel (from GNU time).
 
 Usage: tools/.venv/bin/python tools/bench_frontend.py [FRAME.png] [--reps N] [--process N]
 """
@@ -61,19 +61,26 @@ def polanalyser_chain(raw, muellers):
 
 def run_process(exe, frame, extra):
     """One `polar-vision stokes` run into a fresh folder: (wall s, stderr split line,
-    output bytes on disk, peak RSS in bytes)."""
+    output bytes on disk, peak RSS in bytes or None).
+
+    The peak comes from GNU time (/usr/bin/time) around the binary: a child's ru_maxrss
+    from wait4 would include this Python process's own resident set, which the child
+    inherits at fork and reports until it exits (so it measured ~98 B/px instead of ~25)."""
+    gnu_time = Path("/usr/bin/time")
     with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "out"
+        out, rss_file = Path(tmp) / "out", Path(tmp) / "rss"
+        cmd = [str(exe), "stokes", frame, "--out", str(out), *extra]
+        if gnu_time.is_file():
+            cmd = [str(gnu_time), "-f", "%M", "-o", str(rss_file), *cmd]
         t = time.perf_counter()
-        proc = subprocess.Popen([str(exe), "stokes", frame, "--out", str(out), *extra], stderr=subprocess.PIPE, text=True)
-        _, status, usage = os.wait4(proc.pid, 0)
+        proc = subprocess.run(cmd, stderr=subprocess.PIPE, text=True)
         wall = time.perf_counter() - t
-        err = proc.stderr.read()
-        if os.waitstatus_to_exitcode(status) != 0:
-            raise SystemExit(f"polar-vision stokes {frame} {' '.join(extra)} failed:\n{err}")
+        if proc.returncode != 0:
+            raise SystemExit(f"polar-vision stokes {frame} {' '.join(extra)} failed:\n{proc.stderr}")
         size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
-    split = re.search(r"in ([0-9.]+) ms, outputs in ([0-9.]+) ms", err)
-    return wall, split.groups() if split else ("?", "?"), size, usage.ru_maxrss * 1024
+        peak = int(rss_file.read_text().split()[-1]) * 1024 if rss_file.is_file() else None
+    split = re.search(r"in ([0-9.]+) ms, outputs in ([0-9.]+) ms", proc.stderr)
+    return wall, split.groups() if split else ("?", "?"), size, peak
 
 
 def process_table(frame, runs, t_py, pixels):
@@ -88,10 +95,11 @@ def process_table(frame, runs, t_py, pixels):
         rs = [run_process(exe, frame, extra) for _ in range(runs)]
         wall = statistics.median(r[0] for r in rs)
         mid = min(rs, key=lambda r: abs(r[0] - wall))
-        peak = max(r[3] for r in rs)
+        peaks = [r[3] for r in rs if r[3] is not None]
+        peak = f"{max(peaks) / pixels:9.1f}" if peaks else f"{'?':>9}"
         print(
             f"| {label:<44} | {wall * 1e3:8.0f} | {t_py / wall:13.2f}x | {mid[1][0]:>9} / {mid[1][1]:>8} | "
-            f"{mid[2] / 1e6:10.1f} | {peak / pixels:9.1f} |"
+            f"{mid[2] / 1e6:10.1f} | {peak} |"
         )
 
 
