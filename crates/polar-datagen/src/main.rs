@@ -12,6 +12,10 @@ use polar_datagen::suite::{SizeName, Suite};
 use polar_datagen::{Error, merge, store};
 use polar_render::scene::{MAX_IMAGE_SIDE, MAX_SPP};
 
+/// The allocator of the binaries (see the workspace Cargo.toml).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Make synthetic polarization-camera datasets with the polar-render path tracer.
 ///
 /// Every sample directory holds meta.json, raw.png (16-bit DoFP mosaic, 90/45/135/0 layout),

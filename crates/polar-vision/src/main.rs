@@ -6,6 +6,10 @@ use std::process::ExitCode;
 use clap::Parser;
 use polar_vision::cli::{Cli, dispatch};
 
+/// The allocator of the binaries (see the workspace Cargo.toml).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> ExitCode {
     match dispatch(Cli::parse()) {
         Ok(true) => ExitCode::SUCCESS,
