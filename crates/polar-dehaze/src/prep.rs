@@ -4,6 +4,7 @@
 use polar_image::Gray;
 use polar_sensor::Observation;
 use polar_sensor::mask::SATURATED;
+use rayon::prelude::*;
 
 /// Normalised, sanitised Stokes planes.
 #[derive(Clone, Debug)]
@@ -35,23 +36,24 @@ impl Normalized {
         let norm = |g: &Gray<f32>| {
             let v = g
                 .as_slice()
-                .iter()
+                .par_iter()
                 .map(|&x| if x.is_finite() { x / scale } else { 0.0 })
                 .collect();
             Gray::from_vec(g.width(), g.height(), v).expect("size matches")
         };
         let (s0, s1, s2) = (p.s0.as_slice(), p.s1.as_slice(), p.s2.as_slice());
         let valid: Vec<bool> = (0..s0.len())
+            .into_par_iter()
             .map(|k| obs.is_valid(k) && s0[k].is_finite() && s1[k].is_finite() && s2[k].is_finite())
             .collect();
         let saturated = obs
             .flags
             .as_slice()
-            .iter()
+            .par_iter()
             .filter(|&&f| f & SATURATED != 0)
             .count();
         let unusable = valid
-            .iter()
+            .par_iter()
             .filter(|v| !**v)
             .count()
             .saturating_sub(saturated);

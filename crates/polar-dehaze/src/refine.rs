@@ -110,28 +110,19 @@ pub fn noise_sigma(input: &Normalized) -> f32 {
     if w < 3 || h < 3 {
         return 0.0;
     }
-    let s0 = input.s0.as_slice();
-    let mut r: Vec<f32> = Vec::with_capacity((w - 2) * (h - 2));
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let k = y * w + x;
-            let rows = [k - w, k, k + w];
-            if rows
+    let (s0, valid) = (input.s0.as_slice(), &input.valid);
+    let responses = (1..h - 1)
+        .flat_map(|y| (1..w - 1).map(move |x| y * w + x))
+        .filter(|&k| {
+            [k - w, k, k + w]
                 .iter()
-                .any(|&c| !(input.valid[c - 1] && input.valid[c] && input.valid[c + 1]))
-            {
-                continue;
-            }
+                .all(|&c| valid[c - 1] && valid[c] && valid[c + 1])
+        })
+        .map(|k| {
             let d2 = |c: usize| s0[c - 1] - 2.0 * s0[c] + s0[c + 1];
-            r.push((d2(rows[0]) - 2.0 * d2(rows[1]) + d2(rows[2])).abs());
-        }
-    }
-    if r.is_empty() {
-        return 0.0;
-    }
-    let mid = r.len() / 2;
-    let med = *r.select_nth_unstable_by(mid, f32::total_cmp).1;
-    1.4826 * med / 6.0
+            (d2(k - w) - 2.0 * d2(k) + d2(k + w)).abs()
+        });
+    polar_image::quantile(responses, 0.5).map_or(0.0, |med| 1.4826 * med / 6.0)
 }
 
 /// Edge-preserving denoising of the normalised S0 before the inversion: the guided filter
