@@ -3,6 +3,7 @@
 
 use polar_image::Gray;
 use polar_imgproc::{Border, box_filter, guided_filter};
+use rayon::prelude::*;
 
 use crate::prep::Normalized;
 use crate::{DehazeError, DehazeOptions};
@@ -111,8 +112,9 @@ pub fn noise_sigma(input: &Normalized) -> f32 {
         return 0.0;
     }
     let (s0, valid) = (input.s0.as_slice(), &input.valid);
-    let responses = (1..h - 1)
-        .flat_map(|y| (1..w - 1).map(move |x| y * w + x))
+    let responses: Vec<f32> = (1..h - 1)
+        .into_par_iter()
+        .flat_map_iter(|y| (1..w - 1).map(move |x| y * w + x))
         .filter(|&k| {
             [k - w, k, k + w]
                 .iter()
@@ -121,8 +123,9 @@ pub fn noise_sigma(input: &Normalized) -> f32 {
         .map(|k| {
             let d2 = |c: usize| s0[c - 1] - 2.0 * s0[c] + s0[c + 1];
             (d2(k - w) - 2.0 * d2(k) + d2(k + w)).abs()
-        });
-    polar_image::quantile(responses, 0.5).map_or(0.0, |med| 1.4826 * med / 6.0)
+        })
+        .collect();
+    polar_image::quantile(responses.iter().copied(), 0.5).map_or(0.0, |med| 1.4826 * med / 6.0)
 }
 
 /// Edge-preserving denoising of the normalised S0 before the inversion: the guided filter
