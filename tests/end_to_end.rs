@@ -55,19 +55,21 @@ fn eval(families: &str, tasks: &str, jobs: &str) -> (tempfile::TempDir, serde_js
 fn train_material_then_eval_with_the_model() {
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("material.knn");
-    let ok = vision(&[
-        "train",
-        "material",
-        arg(standard_ci()),
-        "--family",
-        "materials",
-        "--out",
-        arg(&model),
-        "--max-points",
-        "500",
-    ])
-    .expect("train completes");
-    assert!(ok && model.is_file());
+    let train = |extra: &[&str]| {
+        let mut args = vec![
+            "train",
+            "material",
+            arg(standard_ci()),
+            "--family",
+            "materials",
+            "--out",
+            arg(&model),
+        ];
+        args.extend_from_slice(extra);
+        assert_eq!(vision(&args), Ok(true), "train {extra:?}");
+    };
+    train(&["--max-points", "500"]);
+    assert!(model.is_file());
     let out = dir.path().join("eval");
     let ok = vision(&[
         "eval",
@@ -90,6 +92,38 @@ fn train_material_then_eval_with_the_model() {
         "metal_vs_dielectric_accuracy",
     );
     assert!((0.0..=1.0).contains(&acc), "{acc}");
+    // A resumed eval reuses a record only if the model's contents are the same: the same
+    // file reruns nothing, the file retrained in place (other points) reruns the samples.
+    let record = out
+        .join("samples/materials-00000")
+        .join(vision::EVAL_RECORD);
+    let options = || json(&record)["options"].as_str().unwrap().to_owned();
+    let eval_again = || {
+        vision(&[
+            "eval",
+            arg(standard_ci()),
+            "--family",
+            "materials",
+            "--tasks",
+            "material",
+            "--material-model",
+            arg(&model),
+            "--out",
+            arg(&out),
+        ])
+        .expect("eval completes")
+    };
+    let first = std::fs::read(&record).unwrap();
+    assert!(eval_again());
+    assert_eq!(
+        std::fs::read(&record).unwrap(),
+        first,
+        "an unchanged model reruns"
+    );
+    let before = options();
+    train(&["--max-points", "200"]);
+    assert!(eval_again());
+    assert_ne!(options(), before, "a retrained model reuses old results");
     let bad = dir.path().join("bad.knn");
     std::fs::write(&bad, b"not a model").unwrap();
     let err = vision(&[

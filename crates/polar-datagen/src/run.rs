@@ -128,7 +128,7 @@ pub fn prepare_output(
     let lock = store::lock_dataset(&opts.out)?;
     let record = RunRecord {
         suite: suite.name.clone(),
-        suite_sha256: store::sha256_hex(suite_text.as_bytes()),
+        suite_sha256: polar_io::sha256_hex(suite_text.as_bytes()),
         size: opts.size,
         shard: opts.shard.k,
         shards: opts.shard.n,

@@ -4,12 +4,11 @@
 
 use std::collections::BTreeMap;
 use std::fs;
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::Path;
 
 use polar_render::Polarization;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 
 use crate::Error;
 use crate::params::SampleParams;
@@ -64,30 +63,6 @@ pub struct RunRecord {
     pub expected: usize,
 }
 
-/// Hex SHA-256 of bytes.
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    hex(&Sha256::digest(bytes))
-}
-
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// Hex SHA-256 of a file, streamed.
-pub fn sha256_file(path: &Path) -> Result<String, Error> {
-    let mut file = fs::File::open(path).map_err(Error::io(path))?;
-    let mut hasher = Sha256::new();
-    let mut buf = vec![0u8; 1 << 16];
-    loop {
-        let n = file.read(&mut buf).map_err(Error::io(path))?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&buf[..n]);
-    }
-    Ok(hex(&hasher.finalize()))
-}
-
 /// Checksums of every file under `dir`, keyed by '/'-separated relative path, sorted.
 pub fn checksum_dir(dir: &Path) -> Result<BTreeMap<String, String>, Error> {
     let mut out = BTreeMap::new();
@@ -104,7 +79,7 @@ pub fn checksum_dir(dir: &Path) -> Result<BTreeMap<String, String>, Error> {
                     .map(|c| c.as_os_str().to_string_lossy())
                     .collect::<Vec<_>>()
                     .join("/");
-                out.insert(key, sha256_file(&path)?);
+                out.insert(key, polar_io::sha256_file(&path)?);
             }
         }
     }
@@ -116,7 +91,7 @@ pub fn verify_entry(dataset: &Path, entry: &ManifestEntry) -> Result<(), Error> 
     let dir = dataset.join(&entry.id);
     for (rel, expected) in &entry.files {
         let path = dir.join(rel);
-        let actual = sha256_file(&path)?;
+        let actual = polar_io::sha256_file(&path)?;
         if &actual != expected {
             return Err(Error::Checksum {
                 path,
@@ -289,15 +264,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn sha256_matches_the_fips_test_vector() {
-        // FIPS 180-2 example "abc".
-        assert_eq!(
-            sha256_hex(b"abc"),
-            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
-        );
-    }
-
-    #[test]
     fn torn_last_manifest_line_is_dropped_but_bad_middle_line_is_an_error() {
         let dir = tempfile::tempdir().unwrap();
         fs::write(dir.path().join(MANIFEST), "{\"id\":").unwrap();
@@ -318,6 +284,6 @@ mod tests {
             sums.keys().collect::<Vec<_>>(),
             ["gt/a.bin", polar_io::files::META]
         );
-        assert_eq!(sums["gt/a.bin"], sha256_hex(b"abc"));
+        assert_eq!(sums["gt/a.bin"], polar_io::sha256_hex(b"abc"));
     }
 }

@@ -9,6 +9,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 mod atomic;
+mod checksum;
 mod error;
 mod openexr;
 mod png;
@@ -18,6 +19,7 @@ mod staged;
 mod validate;
 
 pub use atomic::write_atomic;
+pub use checksum::{sha256_file, sha256_hex};
 pub use error::{Error, Result};
 pub use openexr::{
     ExrCompression, exr_channel_names, read_exr, read_exr_channel, read_exr_from, write_exr,

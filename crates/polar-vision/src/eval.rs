@@ -83,12 +83,14 @@ impl EvalRunArgs {
         }
     }
 
-    /// What must be equal for a stored record to be reused.
-    fn fingerprint(&self) -> String {
-        format!(
-            "{:?}|{:?}|{:?}|{:?}",
+    /// What must be equal for a stored record to be reused: the options and the contents
+    /// of the material model they name (a model retrained in place is a different model).
+    fn fingerprint(&self) -> Result<String, CliError> {
+        let model = self.task.material_model_digest()?;
+        Ok(format!(
+            "{:?}|{:?}|{:?}|{:?}|{model:?}",
             self.tasks, self.input, self.read, self.task
-        )
+        ))
     }
 }
 
@@ -132,7 +134,7 @@ pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
         .build()
         .map_err(|e| CliError::Threads(e.to_string()))?;
     let bar = progress(mine.len());
-    let fingerprint = args.run.fingerprint();
+    let fingerprint = args.run.fingerprint()?;
     let records: Vec<(String, Record)> = pool.install(|| {
         mine.par_iter()
             .map(|s| {

@@ -71,6 +71,21 @@ impl TaskArgs {
             CliError::Model(format!("--material-model: {e}"))
         })?)))
     }
+
+    /// Hex SHA-256 of the `--material-model` contents (of the compiled-in model for
+    /// `builtin`), `None` without one: what ties a stored result to the model it was made with.
+    pub fn material_model_digest(&self) -> Result<Option<String>, CliError> {
+        let Some(path) = &self.material_model else {
+            return Ok(None);
+        };
+        let digest = if path.as_os_str() == BUILTIN_MODEL {
+            polar_io::sha256_hex(polar_material::knn::BUILTIN_MODEL)
+        } else {
+            polar_io::sha256_file(path)
+                .map_err(|e| CliError::Model(format!("--material-model: {e}")))?
+        };
+        Ok(Some(digest))
+    }
 }
 
 fn parse_name<T: std::str::FromStr>(s: &str) -> Result<T, String>
