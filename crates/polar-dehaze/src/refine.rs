@@ -111,21 +111,28 @@ pub fn noise_sigma(input: &Normalized) -> f32 {
     if w < 3 || h < 3 {
         return 0.0;
     }
-    let (s0, valid) = (input.s0.as_slice(), &input.valid);
-    let responses: Vec<f32> = (1..h - 1)
+    let (s0, valid) = (input.s0.as_slice(), input.valid.as_slice());
+    let rows: Vec<Vec<f32>> = (1..h - 1)
         .into_par_iter()
-        .flat_map_iter(|y| (1..w - 1).map(move |x| y * w + x))
-        .filter(|&k| {
-            [k - w, k, k + w]
-                .iter()
-                .all(|&c| valid[c - 1] && valid[c] && valid[c + 1])
-        })
-        .map(|k| {
-            let d2 = |c: usize| s0[c - 1] - 2.0 * s0[c] + s0[c + 1];
-            (d2(k - w) - 2.0 * d2(k) + d2(k + w)).abs()
-        })
+        .map(|y| row_responses(s0, valid, w, y))
         .collect();
-    polar_image::quantile(responses.iter().copied(), 0.5).map_or(0.0, |med| 1.4826 * med / 6.0)
+    polar_image::quantile(rows.iter().flatten().copied(), 0.5).map_or(0.0, |med| 1.4826 * med / 6.0)
+}
+
+/// `|[1 -2 1] x [1 -2 1]|` responses of row `y` (`1 <= y < h - 1`) at the pixels whose 3x3
+/// window is valid, left to right.
+fn row_responses(s0: &[f32], valid: &[bool], w: usize, y: usize) -> Vec<f32> {
+    let row = |dy: usize| (y + dy - 1) * w;
+    let (a, b, c) = (row(0), row(1), row(2));
+    let d2 = |k: usize| s0[k - 1] - 2.0 * s0[k] + s0[k + 1];
+    let ok = |k: usize| valid[k - 1] && valid[k] && valid[k + 1];
+    let mut out = Vec::with_capacity(w - 2);
+    for x in 1..w - 1 {
+        if ok(a + x) && ok(b + x) && ok(c + x) {
+            out.push((d2(a + x) - 2.0 * d2(b + x) + d2(c + x)).abs());
+        }
+    }
+    out
 }
 
 /// Edge-preserving denoising of the normalised S0 before the inversion: the guided filter
