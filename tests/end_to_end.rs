@@ -71,34 +71,7 @@ fn train_material_then_eval_with_the_model() {
     train(&["--max-points", "500"]);
     assert!(model.is_file());
     let out = dir.path().join("eval");
-    let ok = vision(&[
-        "eval",
-        arg(standard_ci()),
-        "--family",
-        "materials",
-        "--tasks",
-        "material",
-        "--material-model",
-        arg(&model),
-        "--out",
-        arg(&out),
-    ])
-    .expect("eval completes");
-    assert!(ok, "see {}", out.display());
-    let acc = family_mean(
-        &json(&out.join(vision::METRICS)),
-        "materials",
-        "material",
-        "metal_vs_dielectric_accuracy",
-    );
-    assert!((0.0..=1.0).contains(&acc), "{acc}");
-    // A resumed eval reuses a record only if the model's contents are the same: the same
-    // file reruns nothing, the file retrained in place (other points) reruns the samples.
-    let record = out
-        .join("samples/materials-00000")
-        .join(vision::EVAL_RECORD);
-    let options = || json(&record)["options"].as_str().unwrap().to_owned();
-    let eval_again = || {
+    let eval = || {
         vision(&[
             "eval",
             arg(standard_ci()),
@@ -113,8 +86,22 @@ fn train_material_then_eval_with_the_model() {
         ])
         .expect("eval completes")
     };
+    assert!(eval(), "see {}", out.display());
+    let acc = family_mean(
+        &json(&out.join(vision::METRICS)),
+        "materials",
+        "material",
+        "metal_vs_dielectric_accuracy",
+    );
+    assert!((0.0..=1.0).contains(&acc), "{acc}");
+    // A resumed eval reuses a record only if the model's contents are the same: the same
+    // file reruns nothing, the file retrained in place (other points) reruns the samples.
+    let record = out
+        .join("samples/materials-00000")
+        .join(vision::EVAL_RECORD);
+    let options = || json(&record)["options"].as_str().unwrap().to_owned();
     let first = std::fs::read(&record).unwrap();
-    assert!(eval_again());
+    assert!(eval());
     assert_eq!(
         std::fs::read(&record).unwrap(),
         first,
@@ -122,7 +109,7 @@ fn train_material_then_eval_with_the_model() {
     );
     let before = options();
     train(&["--max-points", "200"]);
-    assert!(eval_again());
+    assert!(eval());
     assert_ne!(options(), before, "a retrained model reuses old results");
     let bad = dir.path().join("bad.knn");
     std::fs::write(&bad, b"not a model").unwrap();
