@@ -24,7 +24,7 @@ pub mod sensor;
 pub mod settings;
 
 pub use demosaic::{DemosaicMethod, demosaic};
-pub use layout::{Mosaic, MosaicSample};
+pub use layout::{Mosaic, MosaicPattern, MosaicSample};
 pub use observation::Observation;
 pub use products::{StokesPlanes, stokes_planes, stokes_planes_from_angles};
 pub use sensor::{SensorModel, SensorOutput};
@@ -51,6 +51,19 @@ pub enum SensorError {
         /// Height in pixels.
         height: usize,
     },
+    /// A colour mosaic whose width or height is not a multiple of 4.
+    #[error(
+        "colour mosaic is {width}x{height}: width and height must be multiples of 4 (whole 4x4 tiles of R, G, G, B polarizer blocks)"
+    )]
+    ColorSize {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+    },
+    /// A mosaic pattern name that is not known.
+    #[error("unknown mosaic pattern `{0}` (known: {known})", known = MosaicPattern::names().join(", "))]
+    UnknownPattern(String),
     /// A demosaicing method name that is not known.
     #[error("unknown demosaicing method `{0}` (known: {known})", known = DemosaicMethod::names().join(", "))]
     UnknownMethod(String),

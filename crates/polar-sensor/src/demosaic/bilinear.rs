@@ -20,6 +20,18 @@ use rayon::prelude::*;
 
 use crate::layout::{Mosaic, MosaicSample, channel_at, offset_of};
 
+/// OpenCV's rounded mean of two samples (Bayer bilinear), `(a + b + 1) >> 1`.
+#[inline(always)]
+pub(crate) fn mean2(a: u32, b: u32) -> u32 {
+    (a + b + 1) >> 1
+}
+
+/// OpenCV's rounded mean of four samples (Bayer bilinear), `(a + b + c + d + 2) >> 2`.
+#[inline(always)]
+pub(crate) fn mean4(a: u32, b: u32, c: u32, d: u32) -> u32 {
+    (a + b + c + d + 2) >> 2
+}
+
 /// The four polarizer values at `(x, y)` of the mosaic `raw`, channel order
 /// `I0, I45, I90, I135`, in DN.
 #[inline]
@@ -41,9 +53,9 @@ pub(crate) fn bilinear_at<T: MosaicSample>(
     let at = |row: &[T], x: usize| -> u32 { row[x].into() };
     let roles = [
         at(mid, x),
-        (at(mid, x - 1) + at(mid, x + 1) + 1) >> 1,
-        (at(up, x) + at(dn, x) + 1) >> 1,
-        (at(up, x - 1) + at(up, x + 1) + at(dn, x - 1) + at(dn, x + 1) + 2) >> 2,
+        mean2(at(mid, x - 1), at(mid, x + 1)),
+        mean2(at(up, x), at(dn, x)),
+        mean4(at(up, x - 1), at(up, x + 1), at(dn, x - 1), at(dn, x + 1)),
     ];
     let mut out = [0; 4];
     for (r, (dx, dy)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
