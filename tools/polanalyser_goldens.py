@@ -7,6 +7,11 @@ Default mode writes small JSON fixtures to crates/polar-sensor/tests/data/:
 Each holds the raw mosaic and polanalyser's outputs: the four demosaiced images
 (COLOR_PolarMono), calcLinearStokes S0..S2, cvtStokesToDoLP, cvtStokesToAoLP and
 applyColorToAoLP(aolp, value=dolp) converted to RGB. Undefined values (NaN) are null.
+  rgb_u8.json, rgb_u16.json             random colour mosaics (IMX250MYR layout)
+  rgb_real_crop_u8.json                 a 32x24 crop of a colour frame made from the bundled
+                                        real frames (see colour_frame)
+The colour fixtures hold, per colour C in R, G, B, the keys "C.i0" ... "C.aolp" of
+polanalyser's COLOR_PolarRGB chain (no picture: ours is of the luminance).
 
 --check runs the real `polar-vision stokes` binary (cargo build --release) on each
 bundled real frame and compares its stokes.exr / dolp.exr / aolp.exr / aolp.png
@@ -32,6 +37,12 @@ ROOT = Path(__file__).resolve().parent.parent
 FIXTURES = ROOT / "crates" / "polar-sensor" / "tests" / "data"
 REAL = ROOT / "tests" / "data" / "real"
 ANGLES = np.deg2rad([0, 45, 90, 135])
+# The IMX250MYR layout of docs/conventions.md, written out here independently of the Rust
+# code: polarizer index (into ANGLES) per [y % 2][x % 2], colour per 2x2 block
+# [(y // 2) % 2][(x // 2) % 2] as an index into OpenCV's B, G, R order (R G / G B).
+ANGLE_AT = np.array([[2, 1], [3, 0]])
+BGR_AT = np.array([[2, 1], [1, 0]])
+COLORS = {"R": 2, "G": 1, "B": 0}  # our channel name -> index in OpenCV's BGR
 
 # Tolerances of --check (full frame, bilinear).
 STOKES_REL_TOL = 1e-4  # max |ours - polanalyser| / max |polanalyser| per S0, S1, S2
@@ -49,6 +60,32 @@ def polanalyser_chain(raw):
         dolp = pa.cvtStokesToDoLP(stokes)
     aolp = pa.cvtStokesToAoLP(stokes)
     return imgs, stokes, dolp, aolp
+
+
+def polanalyser_rgb_chain(raw):
+    """polanalyser's colour chain: demosaicing COLOR_PolarRGB, calcLinearStokes, DoLP, AoLP per colour."""
+    imgs = pa.demosaicing(raw, pa.COLOR_PolarRGB)  # four (h, w, 3) BGR images
+    stokes = pa.calcLinearStokes(np.stack(imgs), ANGLES)  # (h, w, 3 colours, 3)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dolp = pa.cvtStokesToDoLP(stokes)
+    aolp = pa.cvtStokesToAoLP(stokes)
+    return imgs, stokes, dolp, aolp
+
+
+def colour_mosaic(images):
+    """The colour mosaic (IMX250MYR layout) of four (h, w, 3) BGR images behind 0, 45, 90, 135 degrees."""
+    h, w = images[0].shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    return np.stack(images)[ANGLE_AT[y % 2, x % 2], y, x, BGR_AT[(y // 2) % 2, (x // 2) % 2]]
+
+
+def colour_frame():
+    """A full-size colour mosaic from the bundled mono frames: their polarizer images
+    (COLOR_PolarMono) as red (carps), green (camera) and blue (carps upside down)."""
+    frames = [cv2.imread(str(REAL / f), cv2.IMREAD_UNCHANGED) for f in ("carps_IMX250MZR.png", "camera_IMX250MZR.png")]
+    red, green = (pa.demosaicing(f, pa.COLOR_PolarMono) for f in frames)
+    blue = [img[::-1] for img in red]
+    return colour_mosaic([np.dstack([b, g, r]) for r, g, b in zip(red, green, blue)])
 
 
 def aolp_picture_rgb(aolp, dolp):
@@ -86,6 +123,26 @@ def fixture(raw, bits):
     }
 
 
+def colour_fixture(raw, bits):
+    imgs, stokes, dolp, aolp = polanalyser_rgb_chain(raw)
+    h, w = raw.shape
+    out = {
+        "source": f"polanalyser {version('polanalyser')}, OpenCV {cv2.__version__}",
+        "width": w,
+        "height": h,
+        "bits": bits,
+        "raw": raw.ravel().tolist(),
+    }
+    for name, c in COLORS.items():
+        for key, img in zip(["i0", "i45", "i90", "i135"], imgs):
+            out[f"{name}.{key}"] = img[..., c].ravel().tolist()
+        for i in range(3):
+            out[f"{name}.s{i}"] = as_list(stokes[..., c, i])
+        out[f"{name}.dolp"] = as_list(dolp[..., c])
+        out[f"{name}.aolp"] = as_list(aolp[..., c])
+    return out
+
+
 def write_fixtures():
     FIXTURES.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(20261123)
@@ -97,6 +154,14 @@ def write_fixtures():
     for name, raw, bits in [("bilinear_u8", raw8, 8), ("bilinear_u16", raw16, 16), ("real_crop_u8", crop, 8)]:
         path = FIXTURES / f"{name}.json"
         path.write_text(json.dumps(fixture(raw, bits)))
+        print(f"wrote {path.relative_to(ROOT)} ({path.stat().st_size // 1024} KiB)")
+    rgb8 = rng.integers(0, 256, (12, 16), dtype=np.uint8)
+    rgb8[4:8, 4:8] = 0  # a zero 4x4 tile: S0 = 0 in some colours, DoLP/AoLP undefined
+    rgb16 = rng.integers(0, 65536, (16, 20), dtype=np.uint16)
+    rgb_crop = np.ascontiguousarray(colour_frame()[800:824, 1000:1032])
+    for name, raw, bits in [("rgb_u8", rgb8, 8), ("rgb_u16", rgb16, 16), ("rgb_real_crop_u8", rgb_crop, 8)]:
+        path = FIXTURES / f"{name}.json"
+        path.write_text(json.dumps(colour_fixture(raw, bits)))
         print(f"wrote {path.relative_to(ROOT)} ({path.stat().st_size // 1024} KiB)")
 
 

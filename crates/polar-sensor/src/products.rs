@@ -20,6 +20,7 @@ use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
 
 use crate::demosaic::bilinear::bilinear_stokes_row;
+use crate::demosaic::color::split_colors;
 use crate::demosaic::residual::{ResidualRow, StokesRow, guide_and_residual};
 use crate::demosaic::{DemosaicMethod, demosaic};
 use crate::fastmath::dolp_aolp_row;
@@ -138,6 +139,68 @@ impl StokesPlanes {
             .zip(e)
             .map(|((((a, b), c), d), e)| [a, b, c, d, e])
     }
+}
+
+/// Rec. 709 weights of linear R, G, B in the luminance `Y` (ITU-R BT.709, as sRGB).
+pub const LUMA_REC709: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// Stokes, DoLP and AoLP of each colour of a colour polarization mosaic, `[R, G, B]`
+/// (names in [`crate::layout::COLOR_NAMES`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColorStokesPlanes {
+    /// The planes of red, green and blue.
+    pub colors: [StokesPlanes; 3],
+}
+
+impl ColorStokesPlanes {
+    /// `(width, height)` of the planes.
+    pub fn size(&self) -> (usize, usize) {
+        self.colors[0].size()
+    }
+
+    /// Stokes of the luminance `Y = Σ LUMA_REC709[c] · colour c` with its DoLP and AoLP:
+    /// Stokes parameters of incoherent light add, so this is what a sensor of Rec. 709
+    /// luminance response would measure.
+    pub fn luminance(&self) -> StokesPlanes {
+        let (w, h) = self.size();
+        let mut out = StokesPlanes::new(w, h);
+        let src = self
+            .colors
+            .each_ref()
+            .map(|p| [&p.s0, &p.s1, &p.s2].map(|g| g.as_slice()));
+        out.rows_mut()
+            .enumerate()
+            .for_each(|(y, [s0, s1, s2, d, a])| {
+                for (k, dst) in [s0.iter_mut(), s1.iter_mut(), s2.iter_mut()]
+                    .into_iter()
+                    .enumerate()
+                {
+                    for (x, v) in dst.enumerate() {
+                        let i = y * w + x;
+                        *v = (0..3).map(|c| LUMA_REC709[c] * src[c][k][i]).sum();
+                    }
+                }
+                derived_row(s0, s1, s2, d, a);
+            });
+        out
+    }
+}
+
+/// Colour mosaic (width and height multiples of 4) -> per colour `S0, S1, S2, DoLP, AoLP`:
+/// [`crate::demosaic::color::split_colors`], then [`stokes_planes`] of each colour's
+/// mosaic, so each colour runs the monochrome chain of `method` (fused where it is).
+pub fn stokes_planes_rgb<T: MosaicSample>(
+    raw: &Mosaic<T>,
+    method: DemosaicMethod,
+) -> Result<ColorStokesPlanes, SensorError> {
+    let [r, g, b] = split_colors(raw)?;
+    Ok(ColorStokesPlanes {
+        colors: [
+            stokes_planes(&r, method)?,
+            stokes_planes(&g, method)?,
+            stokes_planes(&b, method)?,
+        ],
+    })
 }
 
 /// DoLP and AoLP of one row of Stokes values (NaN where `S0 <= 0` or not finite),

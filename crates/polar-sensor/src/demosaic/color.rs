@@ -32,19 +32,12 @@ pub fn split_colors<T: MosaicSample>(raw: &Mosaic<T>) -> Result<[Mosaic<T>; 3], 
     let src = raw.view();
     let mut out = [(); 3].map(|_| Mosaic::<T>::new(w, h));
     let [r, g, b] = out.each_mut().map(|m| m.as_mut_slice().par_chunks_mut(w));
-    r.zip(g)
-        .zip(b)
-        .enumerate()
-        .for_each(|(y, ((r, g), b))| {
-            for x in 0..w {
-                let rgb = bayer_at(src, x, y);
-                (r[x], g[x], b[x]) = (
-                    T::from_dn(rgb[0]),
-                    T::from_dn(rgb[1]),
-                    T::from_dn(rgb[2]),
-                );
-            }
-        });
+    r.zip(g).zip(b).enumerate().for_each(|(y, ((r, g), b))| {
+        for x in 0..w {
+            let rgb = bayer_at(src, x, y);
+            (r[x], g[x], b[x]) = (T::from_dn(rgb[0]), T::from_dn(rgb[1]), T::from_dn(rgb[2]));
+        }
+    });
     Ok(out)
 }
 
@@ -84,7 +77,14 @@ fn bayer_at<T: MosaicSample>(raw: ImageView<'_, T, 1>, x: usize, y: usize) -> [u
     let hor = || mean2(q(i - 1, j), q(i + 1, j));
     let ver = || mean2(q(i, j - 1), q(i, j + 1));
     let cross = || mean4(q(i - 1, j), q(i + 1, j), q(i, j - 1), q(i, j + 1));
-    let diag = || mean4(q(i - 1, j - 1), q(i + 1, j - 1), q(i - 1, j + 1), q(i + 1, j + 1));
+    let diag = || {
+        mean4(
+            q(i - 1, j - 1),
+            q(i + 1, j - 1),
+            q(i - 1, j + 1),
+            q(i + 1, j + 1),
+        )
+    };
     match (COLOR_AT[j & 1][i & 1], j & 1) {
         (0, _) => [own, cross(), diag()],
         (2, _) => [diag(), cross(), own],
