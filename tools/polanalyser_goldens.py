@@ -15,7 +15,9 @@ polanalyser's COLOR_PolarRGB chain (no picture: ours is of the luminance).
 
 --check runs the real `polar-vision stokes` binary (cargo build --release) on each
 bundled real frame and compares its stokes.exr / dolp.exr / aolp.exr / aolp.png
-with polanalyser on the full frame; exits non-zero if a tolerance is exceeded.
+with polanalyser on the full frame, and with `--pattern rgb` on the full-size colour frame
+(colour_frame) per colour, reading the channels S0.R ... S2.B with Mitsuba's Bitmap;
+exits non-zero if a tolerance is exceeded.
 
 Run with the pinned venv: tools/.venv/bin/python tools/polanalyser_goldens.py [--check]
 """
@@ -187,44 +189,77 @@ def circular_diff(a, b):
     return np.minimum(d, np.pi - d)
 
 
+def compare(label, ours, dolp_ours, aolp_ours, stokes, dolp, aolp, failures):
+    """Our S0..S2 (dict by name), DoLP and AoLP against polanalyser's, within the tolerances above."""
+    for i, name in enumerate(["S0", "S1", "S2"]):
+        ref = stokes[..., i]
+        rel = np.max(np.abs(ours[name] - ref)) / np.max(np.abs(ref))
+        print(f"  {label}{name}: max |diff| / max |ref| = {rel:.2e} (tol {STOKES_REL_TOL:.0e})")
+        if not rel <= STOKES_REL_TOL:
+            failures.append(f"{label}{name} {rel:.2e}")
+    defined = np.isfinite(dolp)
+    if not np.array_equal(defined, np.isfinite(dolp_ours)):
+        failures.append(f"{label}DoLP NaN pattern differs")
+    dd = np.max(np.abs(dolp_ours[defined] - dolp[defined]), initial=0)
+    # AoLP is arbitrary where S1 = S2 = 0 (polanalyser's pseudo-inverse leaves ~1e-16 there,
+    # ours exact zeros): compare where the polarization is at least 1 DN.
+    polarized = defined & (np.hypot(stokes[..., 1], stokes[..., 2]) >= 1)
+    da = np.max(circular_diff(aolp_ours[polarized], aolp[polarized]), initial=0)
+    print(f"  {label}DoLP max |diff| = {dd:.2e} (tol {DOLP_ABS_TOL:.0e}); AoLP max |diff| = {da:.2e} rad (tol {AOLP_ABS_TOL:.0e}, where |S1,S2| >= 1 DN)")
+    if not dd <= DOLP_ABS_TOL:
+        failures.append(f"{label}DoLP {dd:.2e}")
+    if not da <= AOLP_ABS_TOL:
+        failures.append(f"{label}AoLP {da:.2e}")
+
+
+def check_mono(exe, frame, failures):
+    raw = cv2.imread(str(frame), cv2.IMREAD_UNCHANGED)
+    _, stokes, dolp, aolp = polanalyser_chain(raw)
+    with tempfile.TemporaryDirectory() as out:
+        subprocess.run([str(exe), "stokes", str(frame), "--out", out, "--demosaic", "bilinear"], check=True)
+        ours = read_exr(Path(out) / "stokes.exr")
+        our_dolp = read_exr(Path(out) / "dolp.exr")["Y"]
+        our_aolp = read_exr(Path(out) / "aolp.exr")["Y"]
+        picture = cv2.imread(str(Path(out) / "aolp.png"), cv2.IMREAD_UNCHANGED)[..., ::-1]
+    print(f"{frame.name}:")
+    compare(f"{frame.name} ", ours, our_dolp, our_aolp, stokes, dolp, aolp, failures)
+    diff = np.abs(picture.astype(int) - aolp_picture_rgb(aolp, dolp).astype(int)).max(axis=-1)
+    flips = np.mean(diff > PICTURE_DN_TOL)
+    dp = 0 if flips <= PICTURE_FLIP_FRACTION else diff.max()
+    print(f"  aolp.png: {100 * flips:.4f}% of pixels differ by more than {PICTURE_DN_TOL} DN (max {diff.max()}; tol {100 * PICTURE_FLIP_FRACTION}%)")
+    if not dp <= PICTURE_DN_TOL:
+        failures.append(f"{frame.name} aolp.png {dp}")
+
+
+def check_colour(exe, failures):
+    """`polar-vision stokes --pattern rgb` on the full-size colour frame: the channel names
+    Mitsuba's reader sees, and per colour the values of polanalyser's COLOR_PolarRGB chain."""
+    raw = colour_frame()
+    _, stokes, dolp, aolp = polanalyser_rgb_chain(raw)
+    with tempfile.TemporaryDirectory() as out:
+        frame = Path(out) / "colour.png"
+        cv2.imwrite(str(frame), raw)
+        result = Path(out) / "out"
+        subprocess.run([str(exe), "stokes", str(frame), "--out", str(result), "--demosaic", "bilinear", "--pattern", "rgb"], check=True)
+        ours = read_exr(result / "stokes.exr")
+        our_dolp = read_exr(result / "dolp.exr")
+        our_aolp = read_exr(result / "aolp.exr")
+    names = [f"S{i}.{c}" for i in range(3) for c in COLORS]
+    print(f"colour frame (carps, camera, carps flipped as R, G, B): stokes.exr channels {sorted(ours)}")
+    if sorted(ours) != sorted(names):
+        failures.append(f"colour stokes.exr channels {sorted(ours)}, expected {sorted(names)}")
+        return
+    for name, c in COLORS.items():
+        mine = {f"S{i}": ours[f"S{i}.{name}"] for i in range(3)}
+        compare(f"colour {name} ", mine, our_dolp[name], our_aolp[name], stokes[..., c, :], dolp[..., c], aolp[..., c], failures)
+
+
 def check():
     exe = build_binary()
     failures = []
     for frame in sorted(REAL.glob("*.png")):
-        raw = cv2.imread(str(frame), cv2.IMREAD_UNCHANGED)
-        _, stokes, dolp, aolp = polanalyser_chain(raw)
-        with tempfile.TemporaryDirectory() as out:
-            subprocess.run([str(exe), "stokes", str(frame), "--out", out, "--demosaic", "bilinear"], check=True)
-            ours = read_exr(Path(out) / "stokes.exr")
-            our_dolp = read_exr(Path(out) / "dolp.exr")["Y"]
-            our_aolp = read_exr(Path(out) / "aolp.exr")["Y"]
-            picture = cv2.imread(str(Path(out) / "aolp.png"), cv2.IMREAD_UNCHANGED)[..., ::-1]
-        print(f"{frame.name}:")
-        for i, name in enumerate(["S0", "S1", "S2"]):
-            ref = stokes[..., i]
-            rel = np.max(np.abs(ours[name] - ref)) / np.max(np.abs(ref))
-            print(f"  {name}: max |diff| / max |ref| = {rel:.2e} (tol {STOKES_REL_TOL:.0e})")
-            if not rel <= STOKES_REL_TOL:
-                failures.append(f"{frame.name} {name} {rel:.2e}")
-        defined = np.isfinite(dolp)
-        if not np.array_equal(defined, np.isfinite(our_dolp)):
-            failures.append(f"{frame.name}: DoLP NaN pattern differs")
-        dd = np.max(np.abs(our_dolp[defined] - dolp[defined]), initial=0)
-        # AoLP is arbitrary where S1 = S2 = 0 (polanalyser's pseudo-inverse leaves ~1e-16 there,
-        # ours exact zeros): compare where the polarization is at least 1 DN.
-        polarized = defined & (np.hypot(stokes[..., 1], stokes[..., 2]) >= 1)
-        da = np.max(circular_diff(our_aolp[polarized], aolp[polarized]), initial=0)
-        diff = np.abs(picture.astype(int) - aolp_picture_rgb(aolp, dolp).astype(int)).max(axis=-1)
-        flips = np.mean(diff > PICTURE_DN_TOL)
-        dp = 0 if flips <= PICTURE_FLIP_FRACTION else diff.max()
-        print(f"  DoLP max |diff| = {dd:.2e} (tol {DOLP_ABS_TOL:.0e}); AoLP max |diff| = {da:.2e} rad (tol {AOLP_ABS_TOL:.0e}, where |S1,S2| >= 1 DN)")
-        print(f"  aolp.png: {100 * flips:.4f}% of pixels differ by more than {PICTURE_DN_TOL} DN (max {diff.max()}; tol {100 * PICTURE_FLIP_FRACTION}%)")
-        if not dd <= DOLP_ABS_TOL:
-            failures.append(f"{frame.name} DoLP {dd:.2e}")
-        if not da <= AOLP_ABS_TOL:
-            failures.append(f"{frame.name} AoLP {da:.2e}")
-        if not dp <= PICTURE_DN_TOL:
-            failures.append(f"{frame.name} aolp.png {dp}")
+        check_mono(exe, frame, failures)
+    check_colour(exe, failures)
     if failures:
         print("FAILED:", "; ".join(failures))
         return 1

@@ -9,7 +9,9 @@
 use polar_image::Gray;
 use rayon::prelude::*;
 
+use crate::SensorError;
 use crate::demosaic::DemosaicMethod;
+use crate::demosaic::color::split_colors;
 use crate::layout::{Mosaic, MosaicSample};
 
 /// Flag bit: a raw sample used by this pixel is saturated.
@@ -35,6 +37,37 @@ pub fn validity_mask<T: MosaicSample>(
             *m = if s { SATURATED } else { 0 } | if v > 0.0 && v.is_finite() { 0 } else { ZERO };
         });
     mask
+}
+
+/// [`validity_mask`] of a colour mosaic ([`crate::MosaicPattern::Rgb`]) whose Stokes planes
+/// (e.g. the luminance of [`crate::ColorStokesPlanes`]) have `S0` `s0`: [`SATURATED`] where
+/// a raw sample behind any colour of the pixel is. Found by sending an indicator (4 at
+/// saturated samples, else 0) through the same colour split: a rounded mean of up to four
+/// samples with a 4 among them is at least 1, so the indicator marks exactly the split
+/// samples that read a saturated one, and [`validity_mask`] of each colour's indicator
+/// spreads that over the demosaicing support.
+pub fn validity_mask_rgb<T: MosaicSample>(
+    raw: &Mosaic<T>,
+    saturation: u32,
+    method: DemosaicMethod,
+    s0: &Gray<f32>,
+) -> Result<Gray<u8>, SensorError> {
+    let (w, h) = raw.size();
+    let hit: Vec<u8> = raw
+        .as_slice()
+        .par_iter()
+        .map(|&v| if v.into() >= saturation { 4 } else { 0 })
+        .collect();
+    let colours = split_colors(&Mosaic::from_vec(w, h, hit).expect("size of raw"))?;
+    let mut mask = validity_mask(&colours[0], 1, method, s0);
+    for c in &colours[1..] {
+        let more = validity_mask(c, 1, method, s0);
+        mask.as_mut_slice()
+            .par_iter_mut()
+            .zip(more.as_slice())
+            .for_each(|(m, &f)| *m |= f);
+    }
+    Ok(mask)
 }
 
 /// `true` at output pixels whose demosaicing support holds a sample `>= saturation`.
@@ -105,6 +138,30 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// One saturated sample of a colour mosaic flags exactly the pixels whose value reads
+    /// it: those whose luminance S0 changes when the sample changes (bilinear), and none else.
+    #[test]
+    fn saturated_colour_sample_flags_the_pixels_it_reaches() {
+        let (w, h) = (16, 16);
+        let base: Vec<u16> = (0..w * h).map(|k| 1000 + (k * 7 % 50) as u16).collect();
+        let lum = |data: Vec<u16>| {
+            let raw = Mosaic::from_vec(w, h, data).unwrap();
+            crate::stokes_planes_rgb(&raw, DemosaicMethod::Bilinear)
+                .unwrap()
+                .luminance()
+        };
+        let mut sat = base.clone();
+        sat[6 * w + 9] = 4095;
+        let raw = Mosaic::from_vec(w, h, sat.clone()).unwrap();
+        let (a, b) = (lum(base), lum(sat));
+        let mask = validity_mask_rgb(&raw, 4095, DemosaicMethod::Bilinear, &b.s0).unwrap();
+        for k in 0..w * h {
+            let changed = a.s0.as_slice()[k] != b.s0.as_slice()[k];
+            assert_eq!(mask.as_slice()[k] == SATURATED, changed, "pixel {k}");
+        }
+        assert!(mask.as_slice().contains(&SATURATED));
     }
 
     #[test]
