@@ -24,7 +24,7 @@ use crate::demosaic::color::split_colors;
 use crate::demosaic::residual::{ResidualRow, StokesRow, guide_and_residual};
 use crate::demosaic::{DemosaicMethod, demosaic};
 use crate::fastmath::dolp_aolp_row;
-use crate::layout::{Mosaic, MosaicSample};
+use crate::layout::{Mosaic, MosaicPattern, MosaicSample};
 use crate::{SensorError, check_mosaic_size};
 
 /// Linear Stokes parameters and the derived DoLP and AoLP, one plane each.
@@ -153,6 +153,13 @@ pub struct ColorStokesPlanes {
 }
 
 impl ColorStokesPlanes {
+    /// Zero-filled planes of `width x height` for each colour.
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            colors: std::array::from_fn(|_| StokesPlanes::new(width, height)),
+        }
+    }
+
     /// `(width, height)` of the planes.
     pub fn size(&self) -> (usize, usize) {
         self.colors[0].size()
@@ -193,14 +200,25 @@ pub fn stokes_planes_rgb<T: MosaicSample>(
     raw: &Mosaic<T>,
     method: DemosaicMethod,
 ) -> Result<ColorStokesPlanes, SensorError> {
-    let [r, g, b] = split_colors(raw)?;
-    Ok(ColorStokesPlanes {
-        colors: [
-            stokes_planes(&r, method)?,
-            stokes_planes(&g, method)?,
-            stokes_planes(&b, method)?,
-        ],
-    })
+    MosaicPattern::Rgb.check_size(raw.width(), raw.height())?;
+    let (w, h) = method.output_size(raw.width(), raw.height());
+    let mut out = ColorStokesPlanes::new(w, h);
+    stokes_planes_rgb_into(raw, method, &mut out)?;
+    Ok(out)
+}
+
+/// [`stokes_planes_rgb`] into caller-allocated planes of `method.output_size(..)` (only
+/// the three colour mosaics are allocated).
+pub fn stokes_planes_rgb_into<T: MosaicSample>(
+    raw: &Mosaic<T>,
+    method: DemosaicMethod,
+    out: &mut ColorStokesPlanes,
+) -> Result<(), SensorError> {
+    let mosaics = split_colors(raw)?;
+    for (m, planes) in mosaics.iter().zip(&mut out.colors) {
+        stokes_planes_into(m, method, planes)?;
+    }
+    Ok(())
 }
 
 /// DoLP and AoLP of one row of Stokes values (NaN where `S0 <= 0` or not finite),

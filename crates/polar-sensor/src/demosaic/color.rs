@@ -16,6 +16,7 @@
 //!    polanalyser's `COLOR_PolarRGB` bit for bit.
 
 use polar_image::{ImageView, PolarizerStack};
+use pulp::{Arch, Simd, WithSimd};
 use rayon::prelude::*;
 
 use super::DemosaicMethod;
@@ -32,13 +33,87 @@ pub fn split_colors<T: MosaicSample>(raw: &Mosaic<T>) -> Result<[Mosaic<T>; 3], 
     let src = raw.view();
     let mut out = [(); 3].map(|_| Mosaic::<T>::new(w, h));
     let [r, g, b] = out.each_mut().map(|m| m.as_mut_slice().par_chunks_mut(w));
+    let arch = Arch::new();
     r.zip(g).zip(b).enumerate().for_each(|(y, ((r, g), b))| {
-        for x in 0..w {
-            let rgb = bayer_at(src, x, y);
-            (r[x], g[x], b[x]) = (T::from_dn(rgb[0]), T::from_dn(rgb[1]), T::from_dn(rgb[2]));
+        let mut set = |x: usize| {
+            let [vr, vg, vb] = bayer_at(src, x, y).map(T::from_dn);
+            (r[x], g[x], b[x]) = (vr, vg, vb);
+        };
+        if w < 8 || h < 8 {
+            return (0..w).for_each(set);
         }
+        [0, 1, w - 2, w - 1].into_iter().for_each(&mut set);
+        let out = [&mut r[2..w - 2], &mut g[2..w - 2], &mut b[2..w - 2]];
+        arch.dispatch(SplitRow { raw: src, y, out });
     });
     Ok(out)
+}
+
+/// [`split_row_interior`] as a `pulp` operation, so that its loop is compiled for each
+/// SIMD target and the best one of the CPU runs (as the fused rows of [`crate::products`]).
+struct SplitRow<'a, T> {
+    raw: ImageView<'a, T, 1>,
+    y: usize,
+    out: [&'a mut [T]; 3],
+}
+
+impl<T: MosaicSample> WithSimd for SplitRow<'_, T> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        split_row_interior(self.raw, self.y, self.out);
+    }
+}
+
+/// Columns `2..w-2` of output row `y` of [`split_colors`] (half-resolution images at least
+/// 4x4; `out` holds just those columns), equal to [`bayer_at`] there: one uniform loop over
+/// the row with per-column selects instead of per-pixel clamping, so that it vectorises.
+#[inline(always)]
+fn split_row_interior<T: MosaicSample>(
+    raw: ImageView<'_, T, 1>,
+    y: usize,
+    [r, g, b]: [&mut [T]; 3],
+) {
+    let (w, h) = raw.size();
+    let j = (y >> 1).clamp(1, h / 2 - 2);
+    let [up, mid, dn] = [j - 1, j, j + 1].map(|jj| raw.row(2 * jj + (y & 1)));
+    let n = w - 4;
+    // Every slice re-cut to exactly `n` so that the loop has no bounds checks.
+    fn cut<T>(s: &[T], start: usize, n: usize) -> &[T] {
+        &s[start..start + n]
+    }
+    let at = |s, start| cut(s, start, n);
+    let (o, l, rt, u, d) = (at(mid, 2), at(mid, 0), at(mid, 4), at(up, 2), at(dn, 2));
+    let (ul, ur, dl, dr) = (at(up, 0), at(up, 4), at(dn, 0), at(dn, 4));
+    let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
+    // Row parity j and the parity of the half-resolution column (k + 2) >> 1 give the
+    // colour of the centre sample; the other two colours come from the means around it.
+    let odd_j = j & 1 == 1;
+    for k in 0..n {
+        let v = |s: &[T]| -> u32 { s[k].into() };
+        let own = v(o);
+        let (hor, ver) = (mean2(v(l), v(rt)), mean2(v(u), v(d)));
+        let cross = mean4(v(l), v(rt), v(u), v(d));
+        let diag = mean4(v(ul), v(ur), v(dl), v(dr));
+        let odd_i = k & 2 == 0;
+        let rgb = if odd_j {
+            // Green (even i) or blue (odd i) centre.
+            [
+                if odd_i { diag } else { ver },
+                if odd_i { cross } else { own },
+                if odd_i { own } else { hor },
+            ]
+        } else {
+            // Red (even i) or green (odd i) centre.
+            [
+                if odd_i { hor } else { own },
+                if odd_i { own } else { cross },
+                if odd_i { ver } else { diag },
+            ]
+        };
+        (r[k], g[k], b[k]) = (T::from_dn(rgb[0]), T::from_dn(rgb[1]), T::from_dn(rgb[2]));
+    }
 }
 
 /// Demosaics a colour mosaic into the four polarizer images of each colour, `[R, G, B]`
@@ -143,6 +218,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The row kernel (interior columns, SIMD-dispatched) equals the per-pixel [`bayer_at`]
+    /// at every pixel, on every row parity and at the clamped border rows, for u8 and u16.
+    #[test]
+    fn row_kernel_equals_per_pixel_rule() {
+        fn check<T: MosaicSample>(w: usize, h: usize, value: impl Fn(usize) -> u32) {
+            let data = (0..w * h).map(|k| T::from_dn(value(k))).collect();
+            let raw = Mosaic::<T>::from_vec(w, h, data).unwrap();
+            let planes = split_colors(&raw).unwrap();
+            for y in 0..h {
+                for x in 0..w {
+                    let want = bayer_at(raw.view(), x, y);
+                    let got = planes.each_ref().map(|p| p.as_slice()[y * w + x].into());
+                    assert_eq!(got, want, "{w}x{h} ({x},{y})");
+                }
+            }
+        }
+        check::<u8>(24, 16, |k| ((k * 7919) % 251) as u32);
+        check::<u16>(16, 12, |k| ((k * 104_729) % 65_521) as u32);
+        check::<u8>(8, 8, |k| ((k * 31) % 256) as u32);
     }
 
     #[test]
