@@ -125,12 +125,12 @@ fn main() {
     let (memcpy_bw, stream_bw) = bandwidths(reps);
     let bandwidth = memcpy_bw.max(stream_bw);
     let threads = rayon::current_num_threads();
-    // Fused bilinear chain: reads the mosaic once, writes five f32 planes; for colour, it
-    // also writes and reads back the three colour mosaics, and writes five planes per colour.
-    let moved = match pattern {
-        MosaicPattern::Mono => w * h * (bytes_per_sample + 5 * 4),
-        MosaicPattern::Rgb => w * h * (7 * bytes_per_sample + 15 * 4),
-    } as f64;
+    // Fused bilinear chain: reads the mosaic once, writes five f32 planes (per colour).
+    let planes = match pattern {
+        MosaicPattern::Mono => 5,
+        MosaicPattern::Rgb => 15,
+    };
+    let moved = (w * h * (bytes_per_sample + planes * 4)) as f64;
     let bound = moved / bandwidth;
     if json {
         let items: Vec<String> = results

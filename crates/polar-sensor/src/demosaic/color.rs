@@ -34,19 +34,32 @@ pub fn split_colors<T: MosaicSample>(raw: &Mosaic<T>) -> Result<[Mosaic<T>; 3], 
     let mut out = [(); 3].map(|_| Mosaic::<T>::new(w, h));
     let [r, g, b] = out.each_mut().map(|m| m.as_mut_slice().par_chunks_mut(w));
     let arch = Arch::new();
-    r.zip(g).zip(b).enumerate().for_each(|(y, ((r, g), b))| {
-        let mut set = |x: usize| {
-            let [vr, vg, vb] = bayer_at(src, x, y).map(T::from_dn);
-            (r[x], g[x], b[x]) = (vr, vg, vb);
-        };
-        if w < 8 || h < 8 {
-            return (0..w).for_each(set);
-        }
-        [0, 1, w - 2, w - 1].into_iter().for_each(&mut set);
-        let out = [&mut r[2..w - 2], &mut g[2..w - 2], &mut b[2..w - 2]];
-        arch.dispatch(SplitRow { raw: src, y, out });
-    });
+    r.zip(g)
+        .zip(b)
+        .enumerate()
+        .for_each(|(y, ((r, g), b))| split_row(src, y, [r, g, b], arch));
     Ok(out)
+}
+
+/// Row `y` of each colour's mosaic of [`split_colors`] (`raw` of a valid colour size), the
+/// row kernel on the SIMD target `arch` where the half-resolution images are at least 4x4.
+pub(crate) fn split_row<T: MosaicSample>(
+    raw: ImageView<'_, T, 1>,
+    y: usize,
+    [r, g, b]: [&mut [T]; 3],
+    arch: Arch,
+) {
+    let (w, h) = raw.size();
+    let mut set = |x: usize| {
+        let [vr, vg, vb] = bayer_at(raw, x, y).map(T::from_dn);
+        (r[x], g[x], b[x]) = (vr, vg, vb);
+    };
+    if w < 8 || h < 8 {
+        return (0..w).for_each(set);
+    }
+    [0, 1, w - 2, w - 1].into_iter().for_each(&mut set);
+    let out = [&mut r[2..w - 2], &mut g[2..w - 2], &mut b[2..w - 2]];
+    arch.dispatch(SplitRow { raw, y, out });
 }
 
 /// [`split_row_interior`] as a `pulp` operation, so that its loop is compiled for each
