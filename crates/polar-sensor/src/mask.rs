@@ -44,8 +44,8 @@ pub fn validity_mask<T: MosaicSample>(
 /// a raw sample behind any colour of the pixel is. Found by sending an indicator (4 at
 /// saturated samples, else 0) through the same colour split: a rounded mean of up to four
 /// samples with a 4 among them is at least 1, so the indicator marks exactly the split
-/// samples that read a saturated one, and [`validity_mask`] of each colour's indicator
-/// spreads that over the demosaicing support.
+/// samples that read a saturated one, and [`validity_mask`] of the largest over the
+/// colours spreads that over the demosaicing support.
 pub fn validity_mask_rgb<T: MosaicSample>(
     raw: &Mosaic<T>,
     saturation: u32,
@@ -58,16 +58,14 @@ pub fn validity_mask_rgb<T: MosaicSample>(
         .par_iter()
         .map(|&v| if v.into() >= saturation { 4 } else { 0 })
         .collect();
-    let colours = split_colors(&Mosaic::from_vec(w, h, hit).expect("size of raw"))?;
-    let mut mask = validity_mask(&colours[0], 1, method, s0);
-    for c in &colours[1..] {
-        let more = validity_mask(c, 1, method, s0);
-        mask.as_mut_slice()
-            .par_iter_mut()
-            .zip(more.as_slice())
-            .for_each(|(m, &f)| *m |= f);
-    }
-    Ok(mask)
+    let [r, g, b] = split_colors(&Mosaic::from_vec(w, h, hit).expect("size of raw"))?;
+    // Flagged in any colour: the spread of the colours' largest indicator (a dilation of
+    // the union is the union of the dilations).
+    let any = (r.as_slice().par_iter().zip(g.as_slice()).zip(b.as_slice()))
+        .map(|((&r, &g), &b)| r.max(g).max(b))
+        .collect();
+    let any = Mosaic::from_vec(w, h, any).expect("size of raw");
+    Ok(validity_mask(&any, 1, method, s0))
 }
 
 /// `true` at output pixels whose demosaicing support holds a sample `>= saturation`.
