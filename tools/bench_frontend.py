@@ -14,13 +14,18 @@ before and after) are printed with the table.
 The Rust side also measures memory bandwidth (memcpy and a STREAM-scale loop) and
 reports the fused chain against the bytes it must move.
 
+Colour (same run): a 2448x2048 colour mosaic (IMX250MYR layout, made from the bundled mono
+frames as in tools/polanalyser_goldens.py) through polanalyser's colour chain
+  demosaicing(COLOR_PolarRGB) + calcStokes + cvtStokesToDoLP + cvtStokesToAoLP (per colour)
+and through polar-sensor's `stokes_planes_rgb_into` (the example with --pattern=rgb).
+
 Whole process (`--process N`): `polar-vision stokes FRAME --out DIR` spawned as a user
 runs it (release build), median of N runs, with the default `residual` and with
 `--demosaic bilinear`, in the same run as polanalyser's chain; reports the split the
 program prints (compute = read + demosaic + products, outputs), the bytes its outputs
 take on disk and its peak resident memory per input pixel (from GNU time).
 
-Usage: tools/.venv/bin/python tools/bench_frontend.py [FRAME.png] [--reps N] [--process N]
+Usage: tools/.venv/bin/python tools/bench_frontend.py [FRAME.png] [--reps N] [--process N] [--no-native]
 """
 
 import argparse
@@ -36,6 +41,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import polanalyser as pa
+from polanalyser_goldens import colour_frame
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -53,6 +59,15 @@ def best_time(reps, f):
 def polanalyser_chain(raw, muellers):
     imgs = pa.demosaicing(raw, pa.COLOR_PolarMono)
     stokes = pa.calcStokes(imgs, muellers)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dolp = pa.cvtStokesToDoLP(stokes)
+    aolp = pa.cvtStokesToAoLP(stokes)
+    return stokes, dolp, aolp
+
+
+def polanalyser_rgb_chain(raw, muellers):
+    imgs = pa.demosaicing(raw, pa.COLOR_PolarRGB)
+    stokes = pa.calcStokes(imgs, muellers)  # (h, w, 3 colours, 3)
     with np.errstate(divide="ignore", invalid="ignore"):
         dolp = pa.cvtStokesToDoLP(stokes)
     aolp = pa.cvtStokesToAoLP(stokes)
@@ -108,6 +123,7 @@ def main():
     parser.add_argument("frame", nargs="?", default=str(ROOT / "tests/data/real/carps_IMX250MZR.png"))
     parser.add_argument("--reps", type=int, default=10)
     parser.add_argument("--process", type=int, default=0, metavar="N", help="also time the whole polar-vision stokes process, median of N runs")
+    parser.add_argument("--no-native", action="store_true", help="skip the -C target-cpu=native build (a second build of the dependencies in target/native-cpu)")
     args = parser.parse_args()
 
     raw = cv2.imread(args.frame, cv2.IMREAD_UNCHANGED)
@@ -118,6 +134,8 @@ def main():
         "default": (target, {}),
         "-C target-cpu=native": (target / "native-cpu", {"RUSTFLAGS": "-C target-cpu=native"}),
     }
+    if args.no_native:
+        del builds["-C target-cpu=native"]
     exes = {}
     for label, (tdir, env) in builds.items():
         subprocess.run(
@@ -129,13 +147,23 @@ def main():
         )
         exes[label] = tdir / "release" / "examples" / "bench_frontend"
 
+    colour = colour_frame()
+    colour_png = tempfile.NamedTemporaryFile(suffix=".png", delete=False)
+    colour_png.close()
+    cv2.imwrite(colour_png.name, colour)
+
     # Timed back to back once everything is built, so that all rows share the machine's load.
     load_before = os.getloadavg()[0]
     t_py = best_time(max(3, args.reps // 3), lambda: polanalyser_chain(raw, muellers))
-    results = {}
+    t_py_rgb = best_time(max(3, args.reps // 3), lambda: polanalyser_rgb_chain(colour, muellers))
+    results, rgb_results = {}, {}
     for label, exe in exes.items():
         out = subprocess.run([str(exe), args.frame, str(args.reps), "--json"], check=True, capture_output=True, text=True)
         results[label] = json.loads(out.stdout)
+        extra = ["--json", "--pattern=rgb", "--only=bilinear"]
+        out = subprocess.run([str(exe), colour_png.name, str(args.reps), *extra], check=True, capture_output=True, text=True)
+        rgb_results[label] = json.loads(out.stdout)
+    os.unlink(colour_png.name)
 
     h, w = raw.shape
     first = next(iter(results.values()))
@@ -161,6 +189,15 @@ def main():
             bound = f"{t / rs['bound_s']:7.2f}x" if name == "bilinear" else f"{'-':>8}"
             pipeline = f"polar-sensor {name} -> S0,S1,S2,DoLP,AoLP (f32)"
             print(f"| {pipeline:<52} | {label:<22} | {t * 1e3:8.2f} | {t_py / t:13.1f}x | {bound} |")
+    first_rgb = next(iter(rgb_results.values()))
+    print(
+        f"| {'polanalyser COLOR_PolarRGB+calcStokes+DoLP+AoLP (f64)':<52} | {'pip wheel':<22} | {t_py_rgb * 1e3:8.1f} | "
+        f"{'1.0x':>14} | {t_py_rgb / first_rgb['bound_s']:7.1f}x |"
+    )
+    for label, rs in rgb_results.items():
+        t = rs["seconds"]["bilinear"]
+        pipeline = "polar-sensor rgb bilinear -> per colour (f32)"
+        print(f"| {pipeline:<52} | {label:<22} | {t * 1e3:8.2f} | {t_py_rgb / t:13.1f}x | {t / rs['bound_s']:7.2f}x |")
     if args.process:
         process_table(args.frame, args.process, t_py, w * h)
 

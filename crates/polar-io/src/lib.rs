@@ -23,7 +23,7 @@ pub use checksum::{sha256_file, sha256_hex};
 pub use error::{Error, Result};
 pub use openexr::{
     ExrCompression, exr_channel_names, read_exr, read_exr_channel, read_exr_from, write_exr,
-    write_exr_plane, write_exr_planes3, write_exr_with,
+    write_exr_plane, write_exr_planes, write_exr_planes3, write_exr_with,
 };
 pub use png::{
     BitDepth, GrayPng, MosaicPng, check_mosaic_size, read_gray_png, read_gray_png_from,
@@ -82,6 +82,12 @@ pub(crate) fn check_pixels(path: &std::path::Path, width: usize, height: usize) 
 pub const STOKES_CHANNELS: [&str; 4] = ["S0", "S1", "S2", "S3"];
 /// Channel names of a linear Stokes EXR (the vision output when S3 is unknown).
 pub const LINEAR_STOKES_CHANNELS: [&str; 3] = ["S0", "S1", "S2"];
+/// Channel names of a colour linear Stokes EXR (`stokes.exr` of a colour sensor): each of
+/// [`LINEAR_STOKES_CHANNELS`] per colour of [`RGB_CHANNELS`], `S0.R, S0.G, S0.B, S1.R, ...`,
+/// the names Mitsuba 3's `stokes` integrator writes in RGB modes.
+pub const RGB_LINEAR_STOKES_CHANNELS: [&str; 9] = [
+    "S0.R", "S0.G", "S0.B", "S1.R", "S1.G", "S1.B", "S2.R", "S2.G", "S2.B",
+];
 /// Channel names of the four polarizer images (`polarizers.exr`), in the order of
 /// `polar_image::PolarizerStack`.
 pub const POLARIZER_CHANNELS: [&str; 4] = ["I0", "I45", "I90", "I135"];
@@ -89,3 +95,18 @@ pub const POLARIZER_CHANNELS: [&str; 4] = ["I0", "I45", "I90", "I135"];
 pub const RGB_CHANNELS: [&str; 3] = ["R", "G", "B"];
 /// Channel name of a single-channel EXR (`depth.exr`, `dolp.exr`, `aolp.exr`, ...).
 pub const Y_CHANNEL: [&str; 1] = ["Y"];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The colour Stokes names are `<Stokes name>.<colour name>`, Stokes-major.
+    #[test]
+    fn colour_stokes_names_combine_stokes_and_colour_names() {
+        let want: Vec<String> = LINEAR_STOKES_CHANNELS
+            .iter()
+            .flat_map(|s| RGB_CHANNELS.iter().map(move |c| format!("{s}.{c}")))
+            .collect();
+        assert_eq!(RGB_LINEAR_STOKES_CHANNELS.to_vec(), want);
+    }
+}

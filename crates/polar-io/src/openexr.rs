@@ -125,6 +125,35 @@ pub fn write_exr_planes3(
     write_image(path, &single_layer((width, height), compression, channels))
 }
 
+/// Writes any number of planes of one size as the float32 channels `names` (one per plane)
+/// of a single-layer EXR, atomically (e.g. the nine `S0.R` ... `S2.B` of a colour Stokes
+/// image). Each plane is copied once for the encoder; the file equals [`write_exr_with`]'s
+/// of the same pixels.
+pub fn write_exr_planes(
+    path: impl AsRef<Path>,
+    planes: &[&Gray<f32>],
+    names: &[&str],
+    compression: ExrCompression,
+) -> Result<()> {
+    let path = path.as_ref();
+    let texts = channel_texts(path, names)?;
+    if planes.len() != names.len() {
+        return Err(Error::ChannelNames {
+            path: path.to_owned(),
+            names: names.iter().map(|s| s.to_string()).collect(),
+            reason: "one name per plane is needed",
+        });
+    }
+    let size = checked_size(path, planes)?;
+    let channels: Vec<AnyChannel<FlatSamples>> = texts
+        .into_iter()
+        .zip(planes)
+        .map(|(name, p)| AnyChannel::new(name, FlatSamples::F32(p.as_slice().to_vec())))
+        .collect();
+    let channels = AnyChannels::sort(channels.into());
+    write_image(path, &single_layer(size, compression, channels))
+}
+
 /// The common size of `planes`, refusing an empty image or planes of different sizes.
 fn checked_size(path: &Path, planes: &[&Gray<f32>]) -> Result<(usize, usize)> {
     let (width, height) = nonempty(path, planes[0].size())?;

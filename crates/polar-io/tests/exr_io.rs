@@ -8,8 +8,9 @@ use exr::prelude::{
 };
 use polar_image::{Gray, Image, StokesImage};
 use polar_io::{
-    Error, ExrCompression, Rule, STOKES_CHANNELS, check_channels, check_stokes, exr_channel_names,
-    read_exr, read_exr_channel, write_exr, write_exr_plane, write_exr_planes3, write_exr_with,
+    Error, ExrCompression, RGB_LINEAR_STOKES_CHANNELS, Rule, STOKES_CHANNELS, check_channels,
+    check_stokes, exr_channel_names, read_exr, read_exr_channel, write_exr, write_exr_plane,
+    write_exr_planes, write_exr_planes3, write_exr_with,
 };
 
 /// A 4-channel image holding awkward floats: negative, subnormal, huge, signed zero.
@@ -144,6 +145,39 @@ fn planes_in_place_write_the_same_file_as_an_image() {
         matches!(err, Err(Error::Dimensions { width: 0, .. })),
         "{err:?}"
     );
+}
+
+/// Nine planes under the colour Stokes names: the same file as the interleaved 9-channel
+/// image, read back bit-exact by name; a name per plane is required.
+#[test]
+fn colour_stokes_planes_round_trip_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (awkward_stokes(7, 5), awkward_stokes(7, 5));
+    let planes: Vec<Gray<f32>> = (0..9)
+        .map(|k| {
+            if k < 4 {
+                a.channel(k)
+            } else {
+                b.channel((k + 1) % 4)
+            }
+        })
+        .collect();
+    let refs: Vec<&Gray<f32>> = planes.iter().collect();
+    let nine: Image<f32, 9> = Image::from_channels(refs.clone().try_into().unwrap()).unwrap();
+    let (p, q) = (dir.path().join("p.exr"), dir.path().join("q.exr"));
+    let rle = ExrCompression::Rle;
+    write_exr_planes(&p, &refs, &RGB_LINEAR_STOKES_CHANNELS, rle).unwrap();
+    write_exr_with(&q, &nine, RGB_LINEAR_STOKES_CHANNELS, rle).unwrap();
+    assert!(std::fs::read(&p).unwrap() == std::fs::read(&q).unwrap());
+    for (k, name) in RGB_LINEAR_STOKES_CHANNELS.into_iter().enumerate() {
+        assert_eq!(
+            bits(&read_exr_channel(&p, name).unwrap()),
+            bits(&planes[k]),
+            "{name}"
+        );
+    }
+    let err = write_exr_planes(&p, &refs[..8], &RGB_LINEAR_STOKES_CHANNELS, rle).unwrap_err();
+    assert!(matches!(err, Error::ChannelNames { .. }), "{err}");
 }
 
 #[test]

@@ -1,17 +1,20 @@
 //! Speed of the front end on a full frame, next to the machine's memory bandwidth.
 //!
-//! `cargo run --release -p polar-sensor --example bench_frontend -- FRAME.png [REPS] [--json] [--only=METHOD]`
+//! `cargo run --release -p polar-sensor --example bench_frontend -- FRAME.png [REPS] [--json] [--only=METHOD] [--pattern=rgb]`
 //!
 //! Times raw -> S0, S1, S2, DoLP, AoLP (f32, caller-allocated planes) for each
-//! demosaicing method, and a parallel large copy (read + write) as the bandwidth
+//! demosaicing method (per colour for `--pattern=rgb`: a colour mosaic through
+//! `stokes_planes_rgb_into`), and a parallel large copy (read + write) as the bandwidth
 //! yardstick. The lower bound for the fused chain is (bytes read + bytes written) /
 //! bandwidth. `tools/bench_frontend.py` runs polanalyser on the same frame and
 //! prints both in one table.
 
 use std::time::{Duration, Instant};
 
-use polar_sensor::products::{StokesPlanes, simd_target, stokes_planes_into};
-use polar_sensor::{DemosaicMethod, Mosaic, MosaicSample};
+use polar_sensor::products::{
+    ColorStokesPlanes, StokesPlanes, simd_target, stokes_planes_into, stokes_planes_rgb_into,
+};
+use polar_sensor::{DemosaicMethod, Mosaic, MosaicPattern, MosaicSample};
 use rayon::prelude::*;
 
 /// Fastest of `reps` timings of `f` after one warm-up call (the least disturbed by
@@ -60,22 +63,29 @@ fn bench<T: MosaicSample>(
     raw: &Mosaic<T>,
     reps: usize,
     only: Option<&str>,
+    pattern: MosaicPattern,
 ) -> Vec<(DemosaicMethod, Duration)> {
     DemosaicMethod::ALL
         .into_iter()
         .filter(|m| only.is_none_or(|o| o == m.name()))
         .map(|m| {
             let (w, h) = m.output_size(raw.width(), raw.height());
-            let mut out = StokesPlanes::new(w, h);
             let reps = if m == DemosaicMethod::Newton {
                 reps.min(5)
             } else {
                 reps
             };
-            (
-                m,
-                best_time(reps, || stokes_planes_into(raw, m, &mut out).unwrap()),
-            )
+            let t = match pattern {
+                MosaicPattern::Mono => {
+                    let mut out = StokesPlanes::new(w, h);
+                    best_time(reps, || stokes_planes_into(raw, m, &mut out).unwrap())
+                }
+                MosaicPattern::Rgb => {
+                    let mut out = ColorStokesPlanes::new(w, h);
+                    best_time(reps, || stokes_planes_rgb_into(raw, m, &mut out).unwrap())
+                }
+            };
+            (m, t)
         })
         .collect()
 }
@@ -84,6 +94,12 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let json = args.iter().any(|a| a == "--json");
     let only = args.iter().find_map(|a| a.strip_prefix("--only="));
+    let pattern: MosaicPattern = args
+        .iter()
+        .find_map(|a| a.strip_prefix("--pattern="))
+        .map_or(MosaicPattern::Mono, |p| {
+            p.parse().expect("--pattern=mono|rgb")
+        });
     let pos: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
     let path = pos
         .first()
@@ -102,15 +118,19 @@ fn main() {
             png.image.as_slice().iter().map(|&v| v as u8).collect(),
         )
         .unwrap();
-        bench(&raw8, reps, only)
+        bench(&raw8, reps, only, pattern)
     } else {
-        bench(&png.image, reps, only)
+        bench(&png.image, reps, only, pattern)
     };
     let (memcpy_bw, stream_bw) = bandwidths(reps);
     let bandwidth = memcpy_bw.max(stream_bw);
     let threads = rayon::current_num_threads();
-    // Fused bilinear chain: reads the mosaic once, writes five f32 planes.
-    let moved = (w * h * (bytes_per_sample + 5 * 4)) as f64;
+    // Fused bilinear chain: reads the mosaic once, writes five f32 planes (per colour).
+    let planes = match pattern {
+        MosaicPattern::Mono => 5,
+        MosaicPattern::Rgb => 15,
+    };
+    let moved = (w * h * (bytes_per_sample + planes * 4)) as f64;
     let bound = moved / bandwidth;
     if json {
         let items: Vec<String> = results

@@ -10,7 +10,8 @@
 //!   their bounds.
 //!
 //! The mosaic layout is the Sony IMX250MZR one (see [`layout`]): super-pixel
-//! row 0 = `[90°, 45°]`, row 1 = `[135°, 0°]`. The physics (Malus's law, Stokes
+//! row 0 = `[90°, 45°]`, row 1 = `[135°, 0°]`; colour sensors (IMX250MYR) put these
+//! super-pixels under an RGGB Bayer pattern ([`MosaicPattern::Rgb`], [`stokes_planes_rgb`]). The physics (Malus's law, Stokes
 //! from intensities, DoLP, AoLP, Mueller matrices) comes from `polar-optics`.
 
 pub mod demosaic;
@@ -23,10 +24,13 @@ pub mod products;
 pub mod sensor;
 pub mod settings;
 
+pub use demosaic::color::{demosaic_rgb, split_colors};
 pub use demosaic::{DemosaicMethod, demosaic};
-pub use layout::{Mosaic, MosaicSample};
+pub use layout::{Mosaic, MosaicPattern, MosaicSample};
 pub use observation::Observation;
-pub use products::{StokesPlanes, stokes_planes, stokes_planes_from_angles};
+pub use products::{
+    ColorStokesPlanes, StokesPlanes, stokes_planes, stokes_planes_from_angles, stokes_planes_rgb,
+};
 pub use sensor::{SensorModel, SensorOutput};
 pub use settings::SensorSettings;
 
@@ -51,6 +55,19 @@ pub enum SensorError {
         /// Height in pixels.
         height: usize,
     },
+    /// A colour mosaic whose width or height is not a multiple of 4.
+    #[error(
+        "colour mosaic is {width}x{height}: width and height must be multiples of 4 (whole 4x4 tiles of R, G, G, B polarizer blocks)"
+    )]
+    ColorSize {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+    },
+    /// A mosaic pattern name that is not known.
+    #[error("unknown mosaic pattern `{0}` (known: {known})", known = MosaicPattern::names().join(", "))]
+    UnknownPattern(String),
     /// A demosaicing method name that is not known.
     #[error("unknown demosaicing method `{0}` (known: {known})", known = DemosaicMethod::names().join(", "))]
     UnknownMethod(String),

@@ -9,7 +9,9 @@
 use polar_image::Gray;
 use rayon::prelude::*;
 
+use crate::SensorError;
 use crate::demosaic::DemosaicMethod;
+use crate::demosaic::color::split_colors;
 use crate::layout::{Mosaic, MosaicSample};
 
 /// Flag bit: a raw sample used by this pixel is saturated.
@@ -35,6 +37,35 @@ pub fn validity_mask<T: MosaicSample>(
             *m = if s { SATURATED } else { 0 } | if v > 0.0 && v.is_finite() { 0 } else { ZERO };
         });
     mask
+}
+
+/// [`validity_mask`] of a colour mosaic ([`crate::MosaicPattern::Rgb`]) whose Stokes planes
+/// (e.g. the luminance of [`crate::ColorStokesPlanes`]) have `S0` `s0`: [`SATURATED`] where
+/// a raw sample behind any colour of the pixel is. Found by sending an indicator (4 at
+/// saturated samples, else 0) through the same colour split: a rounded mean of up to four
+/// samples with a 4 among them is at least 1, so the indicator marks exactly the split
+/// samples that read a saturated one, and [`validity_mask`] of the largest over the
+/// colours spreads that over the demosaicing support.
+pub fn validity_mask_rgb<T: MosaicSample>(
+    raw: &Mosaic<T>,
+    saturation: u32,
+    method: DemosaicMethod,
+    s0: &Gray<f32>,
+) -> Result<Gray<u8>, SensorError> {
+    let (w, h) = raw.size();
+    let hit: Vec<u8> = raw
+        .as_slice()
+        .par_iter()
+        .map(|&v| if v.into() >= saturation { 4 } else { 0 })
+        .collect();
+    let [r, g, b] = split_colors(&Mosaic::from_vec(w, h, hit).expect("size of raw"))?;
+    // Flagged in any colour: the spread of the colours' largest indicator (a dilation of
+    // the union is the union of the dilations).
+    let any = (r.as_slice().par_iter().zip(g.as_slice()).zip(b.as_slice()))
+        .map(|((&r, &g), &b)| r.max(g).max(b))
+        .collect();
+    let any = Mosaic::from_vec(w, h, any).expect("size of raw");
+    Ok(validity_mask(&any, 1, method, s0))
 }
 
 /// `true` at output pixels whose demosaicing support holds a sample `>= saturation`.
@@ -178,6 +209,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// One saturated sample of a colour mosaic flags exactly the pixels whose value reads
+    /// it: those whose luminance S0 changes when the sample changes (bilinear), and none else.
+    #[test]
+    fn saturated_colour_sample_flags_the_pixels_it_reaches() {
+        let (w, h) = (16, 16);
+        let base: Vec<u16> = (0..w * h).map(|k| 1000 + (k * 7 % 50) as u16).collect();
+        let lum = |data: Vec<u16>| {
+            let raw = Mosaic::from_vec(w, h, data).unwrap();
+            crate::stokes_planes_rgb(&raw, DemosaicMethod::Bilinear)
+                .unwrap()
+                .luminance()
+        };
+        let mut sat = base.clone();
+        sat[6 * w + 9] = 4095;
+        let raw = Mosaic::from_vec(w, h, sat.clone()).unwrap();
+        let (a, b) = (lum(base), lum(sat));
+        let mask = validity_mask_rgb(&raw, 4095, DemosaicMethod::Bilinear, &b.s0).unwrap();
+        for k in 0..w * h {
+            let changed = a.s0.as_slice()[k] != b.s0.as_slice()[k];
+            assert_eq!(mask.as_slice()[k] == SATURATED, changed, "pixel {k}");
+        }
+        assert!(mask.as_slice().contains(&SATURATED));
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //!   polanalyser's `applyColorToAoLP(aolp, value=dolp)` (OpenCV hue `0..179`,
 //!   `COLOR_HSV2BGR`), but returned as RGB.
 //! - [`colormap`]: a scalar image through a viridis-like colour map.
+//! - [`srgb_into`]: linear colour values (a colour sensor's S0) as sRGB.
 //!
 //! Undefined pixels (NaN) are black.
 
@@ -111,6 +112,29 @@ pub fn colormap_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [[u8; 3]]) 
     });
 }
 
+/// Linear R, G, B values divided by `vmax`, clipped to `[0, 1]` and encoded with the sRGB
+/// transfer function (IEC 61966-2-1) to 8 bits; a pixel with a NaN channel is black.
+pub fn srgb_into(rgb: [&[f32]; 3], vmax: f32, out: &mut [[u8; 3]]) {
+    let scale = if vmax > 0.0 { 1.0 / vmax } else { 0.0 };
+    let encode = |v: f32| {
+        let v = (v * scale).clamp(0.0, 1.0);
+        let e = if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (e * 255.0).round() as u8
+    };
+    out.par_iter_mut().enumerate().for_each(|(k, px)| {
+        let v = rgb.map(|c| c[k]);
+        *px = if v.iter().all(|c| !c.is_nan()) {
+            v.map(encode)
+        } else {
+            [0; 3]
+        };
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,6 +154,20 @@ mod tests {
         let d = Gray::from_vec(2, 1, vec![0.5, f32::NAN]).unwrap();
         assert_eq!(aolp_hsv(&a, &d).as_slice(), &[0; 6]);
         assert_eq!(colormap(&a, 0.0, 1.0).pixels()[0], [0, 0, 0]);
+    }
+
+    /// Known sRGB codes: 0 and 1 at the ends, linear 0.5 -> 188, 0.002 on the linear toe -> 7
+    /// (12.92 · 0.002 · 255 = 6.6); the scale divides first; NaN is black.
+    #[test]
+    fn srgb_known_values() {
+        let (r, g, b) = (
+            [0.0, 2.0, 1.0, f32::NAN],
+            [0.5, 4.0, 0.004, 1.0],
+            [1.0, -1.0, 0.0, 1.0],
+        );
+        let mut out = [[9; 3]; 4];
+        srgb_into([&r, &g, &b], 2.0, &mut out);
+        assert_eq!(out, [[0, 137, 188], [255, 255, 0], [188, 7, 0], [0, 0, 0]]);
     }
 
     #[test]

@@ -56,6 +56,30 @@ pub enum CliError {
         /// Suggestion.
         hint: &'static str,
     },
+    /// A raw mosaic whose size does not fit its filter pattern.
+    #[error(
+        "{path}: does not fit the {pattern} pattern (--pattern, or sensor.pattern of meta.json): {source}"
+    )]
+    Pattern {
+        /// The file.
+        path: PathBuf,
+        /// The pattern it was read as.
+        pattern: polar_sensor::MosaicPattern,
+        /// What is wrong.
+        source: polar_sensor::SensorError,
+    },
+    /// A key of a JSON file holds a value that cannot be used.
+    #[error("{path}: `{key}` is {value}; expected {expected}")]
+    MetaValue {
+        /// The file.
+        path: PathBuf,
+        /// The key, dotted (`sensor.pattern`).
+        key: &'static str,
+        /// The value found, as JSON.
+        value: String,
+        /// What is accepted.
+        expected: String,
+    },
     /// Every pixel is zero: no light, nothing to compute (DoLP/AoLP undefined everywhere).
     #[error("{0}: every pixel is 0 (no light); DoLP and AoLP would be undefined everywhere")]
     AllZero(PathBuf),

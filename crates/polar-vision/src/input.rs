@@ -1,9 +1,10 @@
 //! Reading one observation: a raw mosaic PNG, or a sample directory (its `raw.png` by
 //! default, else its `stokes.exr`), into a [`polar_sensor::Observation`] through `polar-io`.
 //!
-//! Nothing here reads our dataset generator's private `meta.json` keys but one optional,
-//! documented one (`camera.fov_deg`, the horizontal field of view, docs/conventions.md),
-//! and `--fov` overrides it; without either the camera is taken as orthographic.
+//! Nothing here reads our dataset generator's private `meta.json` keys but two optional,
+//! documented ones (docs/conventions.md): `camera.fov_deg`, the horizontal field of view
+//! (`--fov` overrides it; without either the camera is taken as orthographic), and
+//! `sensor.pattern`, the filter layout of `raw.png` (`--pattern` overrides it; default mono).
 
 use std::path::{Path, PathBuf};
 
@@ -12,8 +13,11 @@ use polar_image::Mosaic;
 use polar_io::files;
 use polar_io::{LINEAR_STOKES_CHANNELS, MosaicPng};
 use polar_optics::pixel_frame::CameraModel;
-use polar_sensor::mask::{count_saturated, validity_mask};
-use polar_sensor::{DemosaicMethod, Observation, StokesPlanes, stokes_planes};
+use polar_sensor::mask::{count_saturated, validity_mask, validity_mask_rgb};
+use polar_sensor::{
+    ColorStokesPlanes, DemosaicMethod, MosaicPattern, Observation, StokesPlanes, stokes_planes,
+    stokes_planes_rgb,
+};
 use serde_json::{Map, Value};
 
 use crate::error::CliError;
@@ -41,6 +45,25 @@ pub struct InputArgs {
     /// (shifted up, low bits zero). Outputs are in DN of the --bit-depth data either way.
     #[arg(long, value_enum, default_value_t = Align::Right)]
     pub align: Align,
+    /// Filters over a raw mosaic: `mono` (IMX250MZR: polarizers only) or `rgb` (IMX250MYR:
+    /// 2x2 polarizer blocks under an RGGB Bayer pattern, width and height multiples of 4;
+    /// polanalyser's COLOR_PolarRGB). Default: `sensor.pattern` of the sample's meta.json
+    /// where it is given, else mono. With rgb, the Stokes images are per colour and DoLP,
+    /// AoLP, the pictures and the tasks use the Rec. 709 luminance of the colours' Stokes.
+    #[arg(long, value_name = "NAME", value_parser = parse_pattern)]
+    pub pattern: Option<MosaicPattern>,
+}
+
+/// What was read of one input: the observation the tasks take (for a colour mosaic, of
+/// its luminance), the per-colour planes of a colour mosaic, and warnings for the user.
+#[derive(Debug)]
+pub struct Reading {
+    /// Stokes planes (luminance for a colour mosaic), flags and camera.
+    pub obs: Observation,
+    /// Per-colour Stokes planes, for a colour mosaic only.
+    pub colors: Option<ColorStokesPlanes>,
+    /// E.g. saturated pixels, which are flagged.
+    pub warnings: Vec<String>,
 }
 
 /// Alignment of fewer-bit data in wider PNG samples.
@@ -64,6 +87,42 @@ pub enum Source {
 fn parse_method(s: &str) -> Result<DemosaicMethod, String> {
     s.parse()
         .map_err(|e: polar_sensor::SensorError| e.to_string())
+}
+
+fn parse_pattern(s: &str) -> Result<MosaicPattern, String> {
+    s.parse()
+        .map_err(|e: polar_sensor::SensorError| e.to_string())
+}
+
+/// The key of `meta.json` that names the filter layout of `raw.png` (docs/conventions.md).
+pub const META_PATTERN_KEY: &str = "sensor.pattern";
+
+/// The filter layout of the raw mosaic `path`: `flag` (`--pattern`) if given, else
+/// `sensor.pattern` of the `meta.json` beside a sample's `raw.png`, else mono. A value
+/// there that is not a known pattern is an error naming the file and the key.
+pub fn mosaic_pattern(path: &Path, flag: Option<MosaicPattern>) -> Result<MosaicPattern, CliError> {
+    if let Some(p) = flag {
+        return Ok(p);
+    }
+    let dir = match path.parent() {
+        Some(dir) if path.file_name() == Some(files::RAW.as_ref()) => dir,
+        _ => return Ok(MosaicPattern::Mono),
+    };
+    let Some(meta) = polar_io::read_optional_meta(dir)? else {
+        return Ok(MosaicPattern::Mono);
+    };
+    let Some(value) = meta.get("sensor").and_then(|s| s.get("pattern")) else {
+        return Ok(MosaicPattern::Mono);
+    };
+    value
+        .as_str()
+        .and_then(|v| v.parse().ok())
+        .ok_or_else(|| CliError::MetaValue {
+            path: dir.join(files::META),
+            key: META_PATTERN_KEY,
+            value: value.to_string(),
+            expected: format!("one of {}", MosaicPattern::names().join(", ")),
+        })
 }
 
 /// The file an input path resolves to.
@@ -113,21 +172,13 @@ pub fn read_observation(
     file: &InputFile,
     args: &InputArgs,
 ) -> Result<(Observation, Vec<String>), CliError> {
+    read_input(file, args).map(|r| (r.obs, r.warnings))
+}
+
+/// Reads `file`: a raw mosaic in the layout of [`mosaic_pattern`], or a Stokes EXR.
+pub fn read_input(file: &InputFile, args: &InputArgs) -> Result<Reading, CliError> {
     match file {
-        InputFile::Raw(path) => {
-            let bits = args.bit_depth.as_deref().map(|b| {
-                b.parse::<u8>()
-                    .expect("clap restricts the values to 8, 10, 12, 16")
-            });
-            let png = polar_io::read_mosaic(path)?;
-            let (raw, bits) = significant_bits(path, png, bits, args.align)?;
-            let level = saturation_level(&raw, bits);
-            let warning = check_exposure(path, &raw, bits, level)?;
-            let planes = stokes_planes(&raw, args.demosaic)?;
-            let flags = validity_mask(&raw, level, args.demosaic, &planes.s0);
-            let obs = Observation::new(planes, CameraModel::Orthographic).with_flags(flags);
-            Ok((obs, warning.into_iter().collect()))
-        }
+        InputFile::Raw(path) => read_raw(path, args),
         InputFile::Stokes(path) => {
             let stokes = polar_io::read_exr(path, LINEAR_STOKES_CHANNELS)?;
             // As for a raw frame with no light: nothing can be computed anywhere.
@@ -139,9 +190,53 @@ pub fn read_observation(
                 return Err(CliError::NoLight(path.to_owned()));
             }
             let planes = StokesPlanes::from_linear_stokes(&stokes);
-            Ok((Observation::new(planes, CameraModel::Orthographic), vec![]))
+            Ok(Reading {
+                obs: Observation::new(planes, CameraModel::Orthographic),
+                colors: None,
+                warnings: vec![],
+            })
         }
     }
+}
+
+/// A raw mosaic PNG through `--bit-depth`/`--align`, the exposure checks and the
+/// demosaicing of its pattern; a colour mosaic's observation is its luminance.
+fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
+    let bits = args.bit_depth.as_deref().map(|b| {
+        b.parse::<u8>()
+            .expect("clap restricts the values to 8, 10, 12, 16")
+    });
+    let pattern = mosaic_pattern(path, args.pattern)?;
+    let png = polar_io::read_mosaic(path)?;
+    let (raw, bits) = significant_bits(path, png, bits, args.align)?;
+    let (w, h) = raw.size();
+    pattern
+        .check_size(w, h)
+        .map_err(|source| CliError::Pattern {
+            path: path.to_owned(),
+            pattern,
+            source,
+        })?;
+    let level = saturation_level(&raw, bits);
+    let warning = check_exposure(path, &raw, bits, level)?;
+    let (planes, flags, colors) = match pattern {
+        MosaicPattern::Mono => {
+            let planes = stokes_planes(&raw, args.demosaic)?;
+            let flags = validity_mask(&raw, level, args.demosaic, &planes.s0);
+            (planes, flags, None)
+        }
+        MosaicPattern::Rgb => {
+            let colors = stokes_planes_rgb(&raw, args.demosaic)?;
+            let planes = colors.luminance();
+            let flags = validity_mask_rgb(&raw, level, args.demosaic, &planes.s0)?;
+            (planes, flags, Some(colors))
+        }
+    };
+    Ok(Reading {
+        obs: Observation::new(planes, CameraModel::Orthographic).with_flags(flags),
+        colors,
+        warnings: warning.into_iter().collect(),
+    })
 }
 
 /// The camera: `--fov` if given, else `camera.fov_deg` of `meta` (a horizontal field of

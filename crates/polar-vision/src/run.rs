@@ -11,9 +11,9 @@ use polar_io::{GroundTruth, Validation};
 use serde::{Deserialize, Serialize};
 
 use crate::error::CliError;
-use crate::input::{InputArgs, InputFile, Source, camera_model, read_observation, resolve};
+use crate::input::{InputArgs, InputFile, Source, camera_model, read_input, resolve};
 use crate::out_dir;
-use crate::stokes::{Output, write_outputs};
+use crate::stokes::{Output, Planes, write_outputs};
 use crate::task_options::TaskArgs;
 use crate::tasks::{Context, Failure, Task};
 
@@ -111,7 +111,8 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
     let start = Instant::now();
     let dir = sample.is_dir().then_some(sample);
     let meta = dir.map(polar_io::read_optional_meta).transpose()?.flatten();
-    let (mut obs, warnings) = read_observation(&file, &args.read)?;
+    let reading = read_input(&file, &args.read)?;
+    let (mut obs, warnings) = (reading.obs, reading.warnings);
     obs.camera = camera_model(args.task.fov, meta.as_ref());
     let gt = match dir {
         Some(d) => polar_io::read_ground_truth(d, Validation::Check)?,
@@ -122,7 +123,11 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
     let raw_mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let staged = out_dir::stage(out)?;
     let out = staged.path();
-    write_outputs(out, &obs.planes, raw_mask, &Output::ALL)?;
+    let planes = Planes {
+        planes: &obs.planes,
+        colors: reading.colors.as_ref(),
+    };
+    write_outputs(out, planes, raw_mask, &Output::ALL)?;
     std::fs::create_dir_all(out.join(vision::PICTURES))
         .map_err(|e| CliError::write(out.join(vision::PICTURES), e))?;
     let mut ctx = Context {

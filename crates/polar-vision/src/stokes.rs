@@ -7,13 +7,15 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use polar_image::{Gray, quantile};
 use polar_io::files::vision;
-use polar_io::{ExrCompression, LINEAR_STOKES_CHANNELS, Y_CHANNEL};
-use polar_sensor::StokesPlanes;
-use polar_sensor::picture::{aolp_hsv_into, colormap_into};
+use polar_io::{
+    ExrCompression, LINEAR_STOKES_CHANNELS, RGB_CHANNELS, RGB_LINEAR_STOKES_CHANNELS, Y_CHANNEL,
+};
+use polar_sensor::picture::{aolp_hsv_into, colormap_into, srgb_into};
+use polar_sensor::{ColorStokesPlanes, StokesPlanes};
 use rayon::prelude::*;
 
 use crate::error::CliError;
-use crate::input::{InputArgs, InputFile, read_observation, resolve};
+use crate::input::{InputArgs, InputFile, read_input, resolve};
 use crate::out_dir;
 
 /// Arguments of `polar-vision stokes`.
@@ -22,7 +24,12 @@ use crate::out_dir;
     after_help = "Writes to --out: stokes.exr (channels S0, S1, S2, in DN), dolp.exr and aolp.exr \
 (channel Y; NaN where S0 = 0), aolp.png (hue = AoLP, value = DoLP), dolp.png (DoLP 0..1 on a viridis map), \
 s0.png (S0 from 0 to its 99.5th percentile on a viridis map) and mask.png (0 valid, 1 saturated, \
-2 zero intensity; see polar_sensor::mask)."
+2 zero intensity; see polar_sensor::mask).\n\n\
+With --pattern rgb: stokes.exr has the channels S0.R, S0.G, S0.B, S1.R, ... S2.B (per colour, \
+as Mitsuba 3 names them); dolp.exr and aolp.exr have Y (of the Rec. 709 luminance \
+Y = 0.2126 R + 0.7152 G + 0.0722 B of the colours' Stokes vectors) and R, G, B (per colour); \
+s0.png shows S0 in colour (sRGB, from 0 to the 99.5th percentile of the brightest channel); \
+aolp.png, dolp.png and mask.png are of the luminance."
 )]
 pub struct StokesArgs {
     /// A raw mosaic PNG (8- or 16-bit grayscale, IMX250MZR layout), or a sample directory
@@ -46,17 +53,30 @@ pub fn run(args: &StokesArgs) -> Result<(), CliError> {
     let file = resolve(&args.input, None)?;
     out_dir::check(&args.input, &args.out)?;
     let start = Instant::now();
-    let (obs, warnings) = read_observation(&file, &args.read)?;
-    warnings.iter().for_each(|w| eprintln!("warning: {w}"));
+    let reading = read_input(&file, &args.read)?;
+    let obs = &reading.obs;
+    reading
+        .warnings
+        .iter()
+        .for_each(|w| eprintln!("warning: {w}"));
     let mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let computed = start.elapsed();
     let staged = out_dir::stage(&args.out)?;
-    write_outputs(staged.path(), &obs.planes, mask, &args.outputs)?;
+    let planes = Planes {
+        planes: &obs.planes,
+        colors: reading.colors.as_ref(),
+    };
+    write_outputs(staged.path(), planes, mask, &args.outputs)?;
     out_dir::commit(staged)?;
     let (w, h) = obs.size();
     // A Stokes EXR is read as it is: --demosaic does not apply to it.
+    let colour = if reading.colors.is_some() {
+        ", rgb"
+    } else {
+        ""
+    };
     let source = match &file {
-        InputFile::Raw(_) => format!("demosaic {}", args.read.demosaic),
+        InputFile::Raw(_) => format!("demosaic {}{colour}", args.read.demosaic),
         InputFile::Stokes(_) => "Stokes EXR, not demosaiced".into(),
     };
     eprintln!(
@@ -96,60 +116,72 @@ impl Output {
 
 type Job<'a> = Box<dyn FnOnce() -> Result<(), polar_io::Error> + Send + 'a>;
 
+/// What the outputs show: the Stokes planes (of the luminance for a colour mosaic) and,
+/// for a colour mosaic, each colour's planes.
+#[derive(Clone, Copy, Debug)]
+pub struct Planes<'a> {
+    /// S0..S2, DoLP and AoLP of the observation.
+    pub planes: &'a StokesPlanes,
+    /// Per-colour planes of a colour mosaic.
+    pub colors: Option<&'a ColorStokesPlanes>,
+}
+
 /// Writes the selected output files into `out`, encoding them in parallel. EXR files use
 /// RLE compression (lossless; float noise does not deflate much, and ZIP costs several
 /// times the time of the whole computation).
 pub fn write_outputs(
     out: &Path,
-    planes: &StokesPlanes,
+    what: Planes<'_>,
     mask: Option<&Gray<u8>>,
     outputs: &[Output],
 ) -> Result<(), CliError> {
     let want = |o: Output| outputs.contains(&o);
+    let planes = what.planes;
     let rle = ExrCompression::Rle;
     let mut jobs: Vec<Job<'_>> = Vec::new();
     if want(Output::Stokes) {
         jobs.push(Box::new(move || {
-            let s = [&planes.s0, &planes.s1, &planes.s2];
-            polar_io::write_exr_planes3(out.join(vision::STOKES), s, LINEAR_STOKES_CHANNELS, rle)
+            let path = out.join(vision::STOKES);
+            match what.colors {
+                Some(c) => {
+                    let s: Vec<&Gray<f32>> = (0..3)
+                        .flat_map(|k| c.colors.iter().map(move |p| [&p.s0, &p.s1, &p.s2][k]))
+                        .collect();
+                    polar_io::write_exr_planes(path, &s, &RGB_LINEAR_STOKES_CHANNELS, rle)
+                }
+                None => {
+                    let s = [&planes.s0, &planes.s1, &planes.s2];
+                    polar_io::write_exr_planes3(path, s, LINEAR_STOKES_CHANNELS, rle)
+                }
+            }
         }));
     }
-    if want(Output::Dolp) {
+    type Pick = fn(&StokesPlanes) -> &Gray<f32>;
+    let derived: [(Output, &str, Pick); 2] = [
+        (Output::Dolp, vision::DOLP, |p| &p.dolp),
+        (Output::Aolp, vision::AOLP, |p| &p.aolp),
+    ];
+    for (_, name, pick) in derived.into_iter().filter(|d| want(d.0)) {
         jobs.push(Box::new(move || {
-            polar_io::write_exr_plane(out.join(vision::DOLP), &planes.dolp, Y_CHANNEL[0], rle)
-        }));
-    }
-    if want(Output::Aolp) {
-        jobs.push(Box::new(move || {
-            polar_io::write_exr_plane(out.join(vision::AOLP), &planes.aolp, Y_CHANNEL[0], rle)
+            let path = out.join(name);
+            match what.colors {
+                Some(c) => {
+                    let mut p = vec![pick(planes)];
+                    p.extend(c.colors.iter().map(pick));
+                    let names = [
+                        Y_CHANNEL[0],
+                        RGB_CHANNELS[0],
+                        RGB_CHANNELS[1],
+                        RGB_CHANNELS[2],
+                    ];
+                    polar_io::write_exr_planes(path, &p, &names, rle)
+                }
+                None => polar_io::write_exr_plane(path, pick(planes), Y_CHANNEL[0], rle),
+            }
         }));
     }
     if want(Output::Pictures) {
-        let size = planes.s0.size();
-        jobs.push(Box::new(move || {
-            polar_io::write_rgb8_png_rows(out.join(vision::AOLP_PICTURE), size, |y, bytes| {
-                let (px, k) = pixel_rows(size.0, y, bytes);
-                aolp_hsv_into(
-                    &planes.aolp.as_slice()[k.clone()],
-                    &planes.dolp.as_slice()[k],
-                    px,
-                );
-            })
-        }));
-        jobs.push(Box::new(move || {
-            polar_io::write_rgb8_png_rows(out.join(vision::DOLP_PICTURE), size, |y, bytes| {
-                let (px, k) = pixel_rows(size.0, y, bytes);
-                colormap_into(&planes.dolp.as_slice()[k], 0.0, 1.0, px);
-            })
-        }));
-        jobs.push(Box::new(move || {
-            let s0 = planes.s0.as_slice();
-            let s0_max = quantile(s0.iter().copied(), 0.995).unwrap_or(1.0);
-            polar_io::write_rgb8_png_rows(out.join(vision::S0_PICTURE), size, |y, bytes| {
-                let (px, k) = pixel_rows(size.0, y, bytes);
-                colormap_into(&s0[k], 0.0, s0_max, px);
-            })
-        }));
+        push_pictures(&mut jobs, out, what);
     }
     if let Some(mask) = mask.filter(|_| want(Output::Mask)) {
         jobs.push(Box::new(move || {
@@ -160,6 +192,50 @@ pub fn write_outputs(
         .map(|job| job())
         .collect::<Result<(), _>>()?;
     Ok(())
+}
+
+/// The jobs of aolp.png, dolp.png (of `what.planes`) and s0.png (in colour for a colour mosaic).
+fn push_pictures<'a>(jobs: &mut Vec<Job<'a>>, out: &'a Path, what: Planes<'a>) {
+    let planes = what.planes;
+    let size = planes.s0.size();
+    jobs.push(Box::new(move || {
+        polar_io::write_rgb8_png_rows(out.join(vision::AOLP_PICTURE), size, |y, bytes| {
+            let (px, k) = pixel_rows(size.0, y, bytes);
+            aolp_hsv_into(
+                &planes.aolp.as_slice()[k.clone()],
+                &planes.dolp.as_slice()[k],
+                px,
+            );
+        })
+    }));
+    jobs.push(Box::new(move || {
+        polar_io::write_rgb8_png_rows(out.join(vision::DOLP_PICTURE), size, |y, bytes| {
+            let (px, k) = pixel_rows(size.0, y, bytes);
+            colormap_into(&planes.dolp.as_slice()[k], 0.0, 1.0, px);
+        })
+    }));
+    jobs.push(Box::new(move || {
+        let path = out.join(vision::S0_PICTURE);
+        match what.colors {
+            Some(c) => {
+                let s0 = c.colors.each_ref().map(|p| p.s0.as_slice());
+                let brightest = (0..s0[0].len()).map(|k| s0[0][k].max(s0[1][k]).max(s0[2][k]));
+                let s0_max = quantile(brightest, 0.995).unwrap_or(1.0);
+                polar_io::write_rgb8_png_rows(path, size, |y, bytes| {
+                    let (px, k) = pixel_rows(size.0, y, bytes);
+                    srgb_into(s0.map(|p| &p[k.clone()]), s0_max, px);
+                })
+            }
+            None => {
+                let s0 = planes.s0.as_slice();
+                let s0_max = quantile(s0.iter().copied(), 0.995).unwrap_or(1.0);
+                polar_io::write_rgb8_png_rows(path, size, |y, bytes| {
+                    let (px, k) = pixel_rows(size.0, y, bytes);
+                    colormap_into(&s0[k], 0.0, s0_max, px);
+                })
+            }
+        }
+    }));
 }
 
 /// A block of RGB rows from row `y` on, as pixels, and the plane indices they show.

@@ -4,8 +4,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use polar_image::Mosaic;
+use polar_image::quantile;
+use polar_io::RGB_LINEAR_STOKES_CHANNELS;
 use polar_io::files::{self, vision};
-use polar_sensor::{DemosaicMethod, stokes_planes};
+use polar_sensor::picture::srgb_into;
+use polar_sensor::{DemosaicMethod, StokesPlanes, stokes_planes, stokes_planes_rgb};
 
 fn run(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_polar-vision"))
@@ -431,4 +434,151 @@ fn max_pixels_refuses_larger_images_from_the_header() {
         &["stokes", p(&input), "--out", p(&out), "--max-pixels", "0"],
         "--max-pixels",
     );
+}
+
+/// `--pattern rgb`: stokes.exr holds the nine colour channels with the library's values,
+/// dolp.exr and aolp.exr the luminance's (Y) and each colour's (R, G, B); s0.png is colour.
+#[test]
+fn rgb_pattern_writes_colour_channels_and_matches_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let raw = mosaic8(16, 12);
+    let input = dir.path().join("colour.png");
+    polar_io::write_gray8_png(&input, &raw).unwrap();
+    let out_dir = dir.path().join("out");
+    let args = [
+        "stokes",
+        p(&input),
+        "--out",
+        p(&out_dir),
+        "--pattern",
+        "rgb",
+    ];
+    let out = run(&[&args[..], &["--demosaic", "bilinear"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("bilinear, rgb"), "{}", stderr(&out));
+    let want = stokes_planes_rgb(&raw, DemosaicMethod::Bilinear).unwrap();
+    let stokes = out_dir.join(vision::STOKES);
+    let mut names = polar_io::exr_channel_names(&stokes).unwrap();
+    names.sort();
+    let mut expected = RGB_LINEAR_STOKES_CHANNELS.map(String::from).to_vec();
+    expected.sort();
+    assert_eq!(names, expected);
+    for (k, name) in RGB_LINEAR_STOKES_CHANNELS.into_iter().enumerate() {
+        let p = &want.colors[k % 3];
+        let plane = [&p.s0, &p.s1, &p.s2][k / 3];
+        assert_eq!(
+            &polar_io::read_exr_channel(&stokes, name).unwrap(),
+            plane,
+            "{name}"
+        );
+    }
+    let lum = want.luminance();
+    for (file, pick) in [
+        (
+            vision::DOLP,
+            (|p: &StokesPlanes| p.dolp.clone()) as fn(&StokesPlanes) -> _,
+        ),
+        (vision::AOLP, |p: &StokesPlanes| p.aolp.clone()),
+    ] {
+        let path = out_dir.join(file);
+        let same = |a: &polar_image::Gray<f32>, b: &polar_image::Gray<f32>| {
+            a.as_slice()
+                .iter()
+                .map(|v| v.to_bits())
+                .eq(b.as_slice().iter().map(|v| v.to_bits()))
+        };
+        assert!(
+            same(
+                &polar_io::read_exr_channel(&path, "Y").unwrap(),
+                &pick(&lum)
+            ),
+            "{file} Y"
+        );
+        for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
+            let got = polar_io::read_exr_channel(&path, name).unwrap();
+            assert!(same(&got, &pick(&want.colors[c])), "{file} {name}");
+        }
+    }
+    // s0.png: the colours' S0 as sRGB up to the 99.5th percentile of the brightest channel.
+    let s0 = polar_io::read_rgb8_png(out_dir.join(vision::S0_PICTURE)).unwrap();
+    let planes = want.colors.each_ref().map(|p| p.s0.as_slice());
+    let brightest = (0..16 * 12).map(|k| planes[0][k].max(planes[1][k]).max(planes[2][k]));
+    let mut picture = vec![[0u8; 3]; 16 * 12];
+    srgb_into(planes, quantile(brightest, 0.995).unwrap(), &mut picture);
+    assert_eq!(s0.pixels(), picture.as_slice());
+}
+
+/// Without `--pattern`, `sensor.pattern` of the sample's meta.json decides; the flag
+/// overrides it; an unknown value there is an error naming the file and the key; a
+/// `sensor` that is not an object (or has no pattern) means mono.
+#[test]
+fn pattern_from_meta_json_and_the_flag_overrides_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = dir.path().join("sample");
+    std::fs::create_dir(&sample).unwrap();
+    polar_io::write_gray8_png(sample.join(files::RAW), &mosaic8(16, 16)).unwrap();
+    let out = dir.path().join("out");
+    let stokes_names = |extra: &[&str]| -> Vec<String> {
+        let res = run(&[&["stokes", p(&sample), "--out", p(&out)], extra].concat());
+        assert!(res.status.success(), "{}", stderr(&res));
+        polar_io::exr_channel_names(out.join(vision::STOKES)).unwrap()
+    };
+    let meta = sample.join(files::META);
+    for (json, colour) in [
+        (r#"{"sensor": {"pattern": "rgb", "bit_depth": 8}}"#, true),
+        (r#"{"sensor": {"pattern": "mono"}}"#, false),
+        (r#"{"sensor": "IMX250MZR"}"#, false),
+        (r#"{}"#, false),
+    ] {
+        std::fs::write(&meta, json).unwrap();
+        assert_eq!(
+            stokes_names(&[]).len(),
+            if colour { 9 } else { 3 },
+            "{json}"
+        );
+    }
+    std::fs::write(&meta, r#"{"sensor": {"pattern": "rgb"}}"#).unwrap();
+    assert_eq!(stokes_names(&["--pattern", "mono"]).len(), 3);
+    std::fs::write(&meta, r#"{"sensor": {"pattern": "cmyk"}}"#).unwrap();
+    fails_with(
+        &["stokes", p(&sample), "--out", p(&out)],
+        "meta.json: `sensor.pattern` is \"cmyk\"; expected one of mono, rgb",
+    );
+    fails_with(
+        &["stokes", p(&sample), "--out", p(&out), "--pattern", "cmyk"],
+        "unknown mosaic pattern `cmyk`",
+    );
+}
+
+#[test]
+fn rgb_mosaic_not_of_whole_4x4_tiles_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("colour.png");
+    polar_io::write_gray8_png(&input, &mosaic8(12, 10)).unwrap();
+    let out = dir.path().join("out");
+    fails_with(
+        &["stokes", p(&input), "--out", p(&out), "--pattern", "rgb"],
+        "does not fit the rgb pattern (--pattern, or sensor.pattern of meta.json): colour mosaic is 12x10: width and height must be multiples of 4",
+    );
+    // The same frame is a valid monochrome mosaic.
+    assert!(
+        run(&["stokes", p(&input), "--out", p(&out)])
+            .status
+            .success()
+    );
+}
+
+#[test]
+fn help_explains_the_colour_pattern() {
+    let help = String::from_utf8(run(&["stokes", "--help"]).stdout).unwrap();
+    for needle in [
+        "--pattern",
+        "rgb",
+        "sensor.pattern",
+        "S0.R",
+        "luminance",
+        "Rec. 709",
+    ] {
+        assert!(help.contains(needle), "help lacks {needle}:\n{help}");
+    }
 }

@@ -20,6 +20,18 @@ use rayon::prelude::*;
 
 use crate::layout::{Mosaic, MosaicSample, channel_at, offset_of};
 
+/// OpenCV's rounded mean of two samples (Bayer bilinear), `(a + b + 1) >> 1`.
+#[inline(always)]
+pub(crate) fn mean2(a: u32, b: u32) -> u32 {
+    (a + b + 1) >> 1
+}
+
+/// OpenCV's rounded mean of four samples (Bayer bilinear), `(a + b + c + d + 2) >> 2`.
+#[inline(always)]
+pub(crate) fn mean4(a: u32, b: u32, c: u32, d: u32) -> u32 {
+    (a + b + c + d + 2) >> 2
+}
+
 /// The four polarizer values at `(x, y)` of the mosaic `raw`, channel order
 /// `I0, I45, I90, I135`, in DN.
 #[inline]
@@ -41,9 +53,9 @@ pub(crate) fn bilinear_at<T: MosaicSample>(
     let at = |row: &[T], x: usize| -> u32 { row[x].into() };
     let roles = [
         at(mid, x),
-        (at(mid, x - 1) + at(mid, x + 1) + 1) >> 1,
-        (at(up, x) + at(dn, x) + 1) >> 1,
-        (at(up, x - 1) + at(up, x + 1) + at(dn, x - 1) + at(dn, x + 1) + 2) >> 2,
+        mean2(at(mid, x - 1), at(mid, x + 1)),
+        mean2(at(up, x), at(dn, x)),
+        mean4(at(up, x - 1), at(up, x + 1), at(dn, x - 1), at(dn, x + 1)),
     ];
     let mut out = [0; 4];
     for (r, (dx, dy)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
@@ -68,8 +80,19 @@ pub(crate) fn bilinear<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
     out
 }
 
-/// Linear Stokes `S0, S1, S2` of one mosaic row `y` after bilinear demosaicing,
-/// without materialising the four images: the fused kernel of [`crate::products`].
+/// The three mosaic rows output row `y` of [`bilinear_stokes_rows`] reads (around the
+/// centre row clamped to `1..h-1`, OpenCV's border rule) and whether that centre is odd.
+#[inline(always)]
+pub(crate) fn rows_around<T>(raw: ImageView<'_, T, 1>, y: usize) -> ([&[T]; 3], bool) {
+    let yc = y.clamp(1, raw.height() - 2);
+    ([raw.row(yc - 1), raw.row(yc), raw.row(yc + 1)], yc & 1 == 1)
+}
+
+/// Linear Stokes `S0, S1, S2` of one mosaic row after bilinear demosaicing, from the
+/// rows `[up, mid, dn]` around its (clamped) centre row and that row's parity
+/// ([`rows_around`]), without materialising the four images: the fused kernel of
+/// [`crate::products`] (the rows may also come from elsewhere, e.g. the colour chain's
+/// per-band buffer).
 ///
 /// Per pixel, with the roles of [`bilinear_at`] (own sample `o`, left/right mean `h`,
 /// up/down mean `v`, diagonal mean `d`): `S0 = (o + h + v + d) / 2` and, from the
@@ -81,17 +104,15 @@ pub(crate) fn bilinear<T: MosaicSample>(raw: &Mosaic<T>) -> PolarizerStack {
 /// over the row with per-column selects, so that it vectorises; `#[inline(always)]`
 /// so that it is compiled for the SIMD target chosen by the caller's dispatch.
 ///
-/// Each output slice has the mosaic width; width and height `>= 4` (smaller frames use
-/// [`bilinear_at`] per pixel).
+/// Each row and output slice has the mosaic width; width and height `>= 4` (smaller
+/// frames use [`bilinear_at`] per pixel).
 #[inline(always)]
-pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
-    raw: ImageView<'_, T, 1>,
-    y: usize,
+pub(crate) fn bilinear_stokes_rows<T: MosaicSample>(
+    [up, mid, dn]: [&[T]; 3],
+    odd_row: bool,
     [s0, s1, s2]: [&mut [f32]; 3],
 ) {
-    let (w, h) = raw.size();
-    let yc = y.clamp(1, h - 2);
-    let (up, mid, dn) = (raw.row(yc - 1), raw.row(yc), raw.row(yc + 1));
+    let w = mid.len();
     let n = w - 2;
     // Every slice re-cut to exactly `n` so that the loop has no bounds checks.
     fn cut<T>(s: &[T], start: usize, n: usize) -> &[T] {
@@ -102,7 +123,6 @@ pub(crate) fn bilinear_stokes_row<T: MosaicSample>(
     let (ul, ur, dl, dr) = (at(up, 0), at(up, 2), at(dn, 0), at(dn, 2));
     let (s0i, s1i, s2i) = (&mut s0[1..=n], &mut s1[1..=n], &mut s2[1..=n]);
     let u = |s: &[T], i: usize| -> i32 { Into::<u32>::into(s[i]) as i32 };
-    let odd_row = yc & 1 == 1;
     for i in 0..n {
         // Sums of at most four 16-bit samples fit in i32; i32 -> f32 is one instruction.
         let own = u(o, i);
@@ -139,7 +159,8 @@ mod tests {
         for y in 0..h {
             // Every parity of row and column is covered (all four super-pixel positions).
             let (mut a, mut b, mut c) = (vec![0.0; w], vec![0.0; w], vec![0.0; w]);
-            bilinear_stokes_row(raw.view(), y, [&mut a, &mut b, &mut c]);
+            let (rows, odd_row) = rows_around(raw.view(), y);
+            bilinear_stokes_rows(rows, odd_row, [&mut a, &mut b, &mut c]);
             for x in 0..w {
                 let i = bilinear_at(raw.view(), x, y).map(|v| v as f32);
                 let want = linear_stokes_from_quad(i[0], i[1], i[2], i[3]);

@@ -11,8 +11,12 @@
 //!   Opt. Express 27, 1376 (2019) (see [`newton`]);
 //! - `residual`: edge-aware residual interpolation around an `S0/2` guide from the
 //!   orthogonal polarizer pairs (Ahmed et al. 2017; Morimatsu et al. 2020), see [`residual`].
+//!
+//! A colour mosaic ([`crate::MosaicPattern::Rgb`]) is first split into one mosaic per
+//! colour ([`color`]), each then demosaiced by any of these methods.
 
 pub mod bilinear;
+pub mod color;
 pub mod newton;
 pub mod residual;
 
