@@ -1,6 +1,7 @@
 //! Runs both shape-from-polarization methods on the `sfp-*` samples of a dataset and
 //! prints the angular error of the normals over object pixels (gt material label != 0),
-//! split by the sensor noise level, with timings.
+//! split by the sensor noise level, with timings, the foreground IoU against the object
+//! mask and a "full" mean that scores missed object pixels as facing the camera.
 //!
 //! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]
 //! [--only TEXT] [--no-speed]` (default `/work/data/dev`; samples `sfp-*` and the Mitsuba
@@ -79,6 +80,8 @@ struct Acc {
     pooled: Vec<(f64, usize)>,
     secs: f64,
     ious: Vec<f64>,
+    /// Mean error with missing object pixels scored as facing the camera.
+    covered: Vec<f64>,
 }
 
 fn main() {
@@ -149,6 +152,11 @@ fn main() {
                     secs * 1e3
                 );
             }
+            let full = angular_error(&facing_where_missing(&shape.normal), gt, Some(&mask))
+                .unwrap()
+                .map_or(f64::NAN, |s| s.mean);
+            e.covered.push(full);
+            line += &format!(" full {full:5.1}");
             let (ez, ea) = split_error(&shape.normal, gt, &mask, fov);
             line += &format!(" zen {ez:4.1} az {ea:4.1}");
             if let Some(d) = &a.debug {
@@ -172,15 +180,28 @@ fn main() {
             .iter()
             .fold((0.0, 0usize), |s, (m, c)| (s.0 + m * *c as f64, s.1 + c));
         println!(
-            "{m:6} {noise:9}: mean {:5.2}  median-of-medians {:5.2}  mean-of-medians {:5.2}  pooled mean {:5.2}  fg IoU {:.2} time/sample {:.1} ms",
+            "{m:6} {noise:9}: mean {:5.2}  median-of-medians {:5.2}  mean-of-medians {:5.2}  pooled mean {:5.2}  fg IoU {:.2} full mean {:5.2} time/sample {:.1} ms",
             e.means.iter().sum::<f64>() / n,
             med.get(med.len() / 2).copied().unwrap_or(f64::NAN),
             e.medians.iter().sum::<f64>() / n,
             num / den.max(1) as f64,
             e.ious.iter().sum::<f64>() / n,
+            e.covered.iter().sum::<f64>() / n,
             e.secs / n * 1e3
         );
     }
+}
+
+/// The estimate with `(0, 0, 1)` (facing the camera) where it has no normal, so a
+/// foreground that misses object pixels is scored on them too.
+fn facing_where_missing(n: &NormalImage) -> NormalImage {
+    let mut out = n.clone();
+    for p in out.pixels_mut() {
+        if p.iter().all(|v| *v == 0.0) {
+            *p = [0.0, 0.0, 1.0];
+        }
+    }
+    out
 }
 
 fn count_missing(n: &NormalImage, mask: &Gray<u8>) -> usize {
