@@ -255,8 +255,8 @@ fn debug_pictures(
 
 fn cue_pictures(dir: &Path, name: &str, obs: &Observation) {
     let cues = polar_shape::cues::Cues::new(obs, 1.5).unwrap();
-    let g = polar_shape::foreground::edge_strength(&cues).unwrap();
-    let t = polar_imgproc::threshold_otsu(&g).unwrap();
+    let z = polar_shape::foreground::rayleigh_statistic(&cues).unwrap();
+    let fgm = polar_shape::foreground::foreground(&cues).unwrap();
     let (w, h) = obs.size();
     let mut rgb = Image::<u8, 3>::new(3 * w, h);
     let px = rgb.pixels_mut();
@@ -268,12 +268,9 @@ fn cue_pictures(dir: &Path, name: &str, obs: &Observation) {
             let d = (cues.dolp[k] * 4.0 * 255.0).min(255.0) as u8;
             let a = (cues.aolp[k] / std::f32::consts::PI * 255.0) as u8;
             px[y * 3 * w + w + x] = [d, a, 255 - a];
-            let e = (g.as_slice()[k] / (2.0 * t) * 255.0).min(255.0) as u8;
-            px[y * 3 * w + 2 * w + x] = if g.as_slice()[k] > t.max(0.15) {
-                [255, e, 0]
-            } else {
-                [e, e, e]
-            };
+            // Rayleigh statistic, gray up to z = 100; orange where foreground.
+            let e = (z.as_slice()[k].sqrt() / 10.0 * 255.0).min(255.0) as u8;
+            px[y * 3 * w + 2 * w + x] = if fgm[k] { [255, e, 0] } else { [e, e, e] };
         }
     }
     polar_io::write_rgb8_png(dir.join(format!("{name}_cues.png")), &upscale(&rgb, 3)).unwrap();
