@@ -1,6 +1,7 @@
 //! Runs both shape-from-polarization methods on the `sfp-*` samples of a dataset and
 //! prints the angular error of the normals over object pixels (gt material label != 0),
-//! split by the sensor noise level, with timings.
+//! split by the sensor noise level, with timings, the foreground IoU against the object
+//! mask and a "full" mean that scores missed object pixels as facing the camera.
 //!
 //! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]
 //! [--only TEXT] [--no-speed]` (default `/work/data/dev`; samples `sfp-*` and the Mitsuba
@@ -79,6 +80,8 @@ struct Acc {
     pooled: Vec<(f64, usize)>,
     secs: f64,
     ious: Vec<f64>,
+    /// Mean error with missing object pixels scored as facing the camera.
+    covered: Vec<f64>,
 }
 
 fn main() {
@@ -149,6 +152,11 @@ fn main() {
                     secs * 1e3
                 );
             }
+            let full = angular_error(&facing_where_missing(&shape.normal), gt, Some(&mask))
+                .unwrap()
+                .map_or(f64::NAN, |s| s.mean);
+            e.covered.push(full);
+            line += &format!(" full {full:5.1}");
             let (ez, ea) = split_error(&shape.normal, gt, &mask, fov);
             line += &format!(" zen {ez:4.1} az {ea:4.1}");
             if let Some(d) = &a.debug {
@@ -172,15 +180,28 @@ fn main() {
             .iter()
             .fold((0.0, 0usize), |s, (m, c)| (s.0 + m * *c as f64, s.1 + c));
         println!(
-            "{m:6} {noise:9}: mean {:5.2}  median-of-medians {:5.2}  mean-of-medians {:5.2}  pooled mean {:5.2}  fg IoU {:.2} time/sample {:.1} ms",
+            "{m:6} {noise:9}: mean {:5.2}  median-of-medians {:5.2}  mean-of-medians {:5.2}  pooled mean {:5.2}  fg IoU {:.2} full mean {:5.2} time/sample {:.1} ms",
             e.means.iter().sum::<f64>() / n,
             med.get(med.len() / 2).copied().unwrap_or(f64::NAN),
             e.medians.iter().sum::<f64>() / n,
             num / den.max(1) as f64,
             e.ious.iter().sum::<f64>() / n,
+            e.covered.iter().sum::<f64>() / n,
             e.secs / n * 1e3
         );
     }
+}
+
+/// The estimate with `(0, 0, 1)` (facing the camera) where it has no normal, so a
+/// foreground that misses object pixels is scored on them too.
+fn facing_where_missing(n: &NormalImage) -> NormalImage {
+    let mut out = n.clone();
+    for p in out.pixels_mut() {
+        if p.iter().all(|v| *v == 0.0) {
+            *p = [0.0, 0.0, 1.0];
+        }
+    }
+    out
 }
 
 fn count_missing(n: &NormalImage, mask: &Gray<u8>) -> usize {
@@ -234,8 +255,8 @@ fn debug_pictures(
 
 fn cue_pictures(dir: &Path, name: &str, obs: &Observation) {
     let cues = polar_shape::cues::Cues::new(obs, 1.5).unwrap();
-    let g = polar_shape::foreground::edge_strength(&cues).unwrap();
-    let t = polar_imgproc::threshold_otsu(&g).unwrap();
+    let z = polar_shape::foreground::rayleigh_statistic(&cues).unwrap();
+    let fgm = polar_shape::foreground::foreground(&cues).unwrap();
     let (w, h) = obs.size();
     let mut rgb = Image::<u8, 3>::new(3 * w, h);
     let px = rgb.pixels_mut();
@@ -247,12 +268,9 @@ fn cue_pictures(dir: &Path, name: &str, obs: &Observation) {
             let d = (cues.dolp[k] * 4.0 * 255.0).min(255.0) as u8;
             let a = (cues.aolp[k] / std::f32::consts::PI * 255.0) as u8;
             px[y * 3 * w + w + x] = [d, a, 255 - a];
-            let e = (g.as_slice()[k] / (2.0 * t) * 255.0).min(255.0) as u8;
-            px[y * 3 * w + 2 * w + x] = if g.as_slice()[k] > t.max(0.15) {
-                [255, e, 0]
-            } else {
-                [e, e, e]
-            };
+            // Rayleigh statistic, gray up to z = 100; orange where foreground.
+            let e = (z.as_slice()[k].sqrt() / 10.0 * 255.0).min(255.0) as u8;
+            px[y * 3 * w + 2 * w + x] = if fgm[k] { [255, e, 0] } else { [e, e, e] };
         }
     }
     polar_io::write_rgb8_png(dir.join(format!("{name}_cues.png")), &upscale(&rgb, 3)).unwrap();

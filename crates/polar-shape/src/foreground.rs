@@ -1,7 +1,10 @@
 //! The objects' pixels, found without ground truth or scene knowledge.
 //!
-//! Objects are regions enclosed by strong edges of brightness or polarization that do
-//! not reach the image border, where the background (floor, walls, sky) does:
+//! Two cues, united:
+//!
+//! **A. Regions enclosed by edges.** Objects are regions enclosed by strong edges of
+//! brightness or polarization that do not reach the image border, where the background
+//! (floor, walls, sky) does:
 //! 1. edge strength `g = √(|∇ ln s|² + k² (|∇ s₁/s₀|² + |∇ s₂/s₀|²))` (Sobel, on the
 //!    normalised brightness `s` and the normalised Stokes vector; `k = 4` weighs a DoLP
 //!    step of 0.25 like a brightness ratio of e), invariant to the global scale;
@@ -12,20 +15,42 @@
 //! 3. the edge-free 4-connected regions touching the border are background; the rest
 //!    (enclosed regions, the edges around them, invalid pixels such as saturated
 //!    highlights inside an object) is the foreground, eroded by 3×3 (undoing the
-//!    dilation) and opened by 3×3 to drop thin edge lines. Invalid pixels are never
-//!    foreground themselves.
+//!    dilation) and opened by 3×3 to drop thin edge lines.
 //!
-//! If nothing is enclosed (a surface filling the view, a tiny image), every valid pixel
-//! is foreground: the frame shows one surface and no occluding contour. This holds on
-//! real frames of objects in front of a background that reaches the border; it fails
-//! for an object cut by the border on all sides or a background split off by shadows.
+//! **B. Coherently polarized regions with an occluding contour** (for silhouettes too weak
+//! to be enclosed by A, e.g. a bright object on a bright floor):
+//! 1. the Rayleigh statistic of the AoLP in a Gaussian window, `z = |Σ g e^{2iα}|² / Σ g²`
+//!    (Mardia & Jupp, *Directional Statistics*, §6.3.1, on the doubled angle): about 1 where
+//!    the AoLP is random (a depolarizing floor, its shadows and texture; only noise and
+//!    demosaicing residue), up to `Σg²⁻¹·(Σg)²` where it is one smooth field (an object).
+//!    Regions are `z` above Otsu's threshold of `z`, opened by 3×3, without components
+//!    smaller than the window (`π (2σ)²` pixels);
+//! 2. holes are filled unless an occluding contour bounds them: the diffuse DoLP peaks
+//!    at grazing, so around a hole seen through an object (a torus) the DoLP is highest
+//!    next to the hole, while around a patch facing the camera (low DoLP) it rises away
+//!    from it ([`fill_object_holes`]);
+//! 3. a region is kept only if its boundary shows the occluding-contour signature: the
+//!    AoLP parallel (diffuse) or perpendicular (specular) to the boundary's 2-D normal,
+//!    i.e. the DoLP-weighted mean of `cos 4Δ` (Δ = AoLP − normal direction) more than
+//!    three standard deviations above 0, its value for a random AoLP ([`has_contour`]).
+//!
+//! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
+//! the view, a tiny image), every valid pixel is foreground: the frame shows one surface
+//! and no occluding contour. A fails where a shadow or floor texture is enclosed by
+//! edges (it takes them in); B fails on objects whose polarization is too weak or
+//! broken up to form a coherent field at the window's scale.
+
+use std::collections::VecDeque;
 
 use polar_image::Gray;
-use polar_imgproc::mask::fill_holes;
-use polar_imgproc::{MorphShape, dilate, erode, gaussian_blur, open, sobel, threshold_otsu};
+use polar_imgproc::mask::{components, fill_holes, remove_small};
+use polar_imgproc::{
+    Border, MorphShape, dilate, erode, gaussian_blur, gaussian_kernel, open, sep_filter, sobel,
+    threshold_otsu,
+};
 
 use crate::ShapeError;
-use crate::cues::Cues;
+use crate::cues::{Cues, image_direction_angle};
 
 /// Weight of a polarization step against a log-brightness step.
 const POLARIZATION_WEIGHT: f32 = 4.0;
@@ -37,8 +62,21 @@ const MIN_EDGE: f32 = 0.1;
 const OTSU_FRACTION: f32 = 0.3;
 /// Brightness floor (normalised) inside the logarithm, so dark noise is not an edge.
 const DARK_FLOOR: f32 = 0.02;
+/// Gaussian window sigma (pixels) of the Rayleigh statistic: wider than the few pixels
+/// over which demosaicing correlates the AoLP of noise, narrower than small objects.
+const COHERENCE_SIGMA: f64 = 3.0;
+/// Sigma (pixels) of the smoothed region mask whose gradient gives the boundary normal.
+const BOUNDARY_SIGMA: f64 = 1.5;
+/// Smoothed-mask gradient (per pixel) above which a region pixel is on its boundary.
+const BOUNDARY_GRADIENT: f64 = 0.05;
+/// Significance (standard deviations) of the occluding-contour signature.
+const CONTOUR_SIGNIFICANCE: f64 = 3.0;
+/// Distances (4-connected steps) from a hole of the near ring (`< RING_NEAR`) and of the
+/// far ring (`RING_NEAR..RING_FAR`) whose DoLP [`fill_object_holes`] compares.
+const RING_NEAR: u32 = 2;
+const RING_FAR: u32 = 6;
 
-/// Foreground mask (`true` on objects) of the cues.
+/// Foreground mask (`true` on objects) of the cues (module doc).
 pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let any_valid = cues.valid.iter().any(|&v| v);
@@ -48,6 +86,21 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     if w < 3 || h < 3 {
         return Ok(cues.valid.clone());
     }
+    let enclosed = enclosed_by_edges(cues)?;
+    let coherent = coherent_regions(cues)?;
+    let fg: Vec<bool> = (0..w * h)
+        .map(|k| cues.valid[k] && (enclosed[k] || coherent[k]))
+        .collect();
+    if fg.iter().any(|&v| v) {
+        Ok(fg)
+    } else {
+        Ok(cues.valid.clone())
+    }
+}
+
+/// Cue A of the module doc (at least 3×3 pixels).
+fn enclosed_by_edges(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
     let g = edge_strength(cues)?;
     let t = (OTSU_FRACTION * threshold_otsu(&g)?).max(MIN_EDGE);
     let edges: Vec<bool> = g
@@ -60,16 +113,7 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     let background = border_regions(&edges, w, h)?;
     let raw: Vec<bool> = background.iter().map(|&b| !b).collect();
     let raw = morph_mask(&raw, w, h, Morph::Erode)?;
-    let cleaned: Vec<bool> = morph_mask(&raw, w, h, Morph::Open)?
-        .into_iter()
-        .zip(&cues.valid)
-        .map(|(f, &ok)| f && ok)
-        .collect();
-    if cleaned.iter().any(|&v| v) {
-        Ok(cleaned)
-    } else {
-        Ok(cues.valid.clone())
-    }
+    morph_mask(&raw, w, h, Morph::Open)
 }
 
 /// The edge strength `g` of the module doc.
@@ -129,4 +173,151 @@ fn morph_mask(mask: &[bool], w: usize, h: usize, op: Morph) -> Result<Vec<bool>,
         Morph::Open => open(&src, &mut dst, MorphShape::Rect, 3, 3)?,
     }
     Ok(dst.as_slice().iter().map(|&v| v > 0.5).collect())
+}
+
+/// Cue B of the module doc (at least 3×3 pixels).
+pub(crate) fn coherent_regions(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let z = rayleigh_statistic(cues)?;
+    let t = threshold_otsu(&z)?;
+    let raw: Vec<bool> = z.as_slice().iter().map(|&v| v > t).collect();
+    let opened = morph_mask(&raw, w, h, Morph::Open)?;
+    let window = std::f64::consts::PI * (2.0 * COHERENCE_SIGMA).powi(2);
+    let regions = remove_small(&opened, w, h, window as usize)?;
+    let filled = fill_object_holes(cues, &regions)?;
+    with_contour(cues, &filled)
+}
+
+/// Rayleigh statistic `z = |Σ g e^{2iα}|² / Σ g²` of the AoLP over a Gaussian window `g`
+/// ([`COHERENCE_SIGMA`]) of the valid pixels with a DoLP; 0 elsewhere. Its expectation
+/// is 1 for independent uniformly random angles.
+pub fn rayleigh_statistic(cues: &Cues) -> Result<Gray<f32>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let used = |k: usize| cues.valid[k] && cues.dolp[k] > 0.0;
+    let plane = |f: &dyn Fn(usize) -> f32| -> Gray<f32> {
+        Gray::from_vec(w, h, (0..w * h).map(f).collect()).expect("sized")
+    };
+    let angle = |k: usize| 2.0 * cues.aolp[k];
+    let cos = plane(&|k| if used(k) { angle(k).cos() } else { 0.0 });
+    let sin = plane(&|k| if used(k) { angle(k).sin() } else { 0.0 });
+    let count = plane(&|k| f32::from(u8::from(used(k))));
+    let g = gaussian_kernel(
+        (COHERENCE_SIGMA * 8.0 + 1.0).round() as usize | 1,
+        COHERENCE_SIGMA,
+    )?;
+    let g2: Vec<f32> = g.iter().map(|v| v * v).collect();
+    let filter = |src: &Gray<f32>, k: &[f32]| -> Result<Gray<f32>, ShapeError> {
+        let mut dst = Gray::new(w, h);
+        sep_filter(src, &mut dst, k, k, Border::Reflect101)?;
+        Ok(dst)
+    };
+    let (c, s, q) = (filter(&cos, &g)?, filter(&sin, &g)?, filter(&count, &g2)?);
+    let (c, s, q) = (c.as_slice(), s.as_slice(), q.as_slice());
+    Ok(plane(&|k| {
+        if used(k) && q[k] > 0.0 {
+            (c[k] * c[k] + s[k] * s[k]) / q[k]
+        } else {
+            0.0
+        }
+    }))
+}
+
+/// `m` with its enclosed holes filled, except holes bounded by an occluding contour: the
+/// mean DoLP of the object pixels within [`RING_NEAR`] steps of the hole above that of
+/// the pixels [`RING_NEAR`] to [`RING_FAR`] steps away (module doc, B.2).
+fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let filled = fill_holes(m, w, h)?;
+    let holes: Vec<bool> = filled.iter().zip(m).map(|(&f, &o)| f && !o).collect();
+    let (hole_id, n) = components(&holes, w, h)?;
+    if n == 0 {
+        return Ok(filled);
+    }
+    // Breadth-first from all holes at once over the region: each pixel joins the ring
+    // sums of the hole that reaches it first.
+    let mut owner = hole_id.clone();
+    let mut dist: Vec<u32> = holes
+        .iter()
+        .map(|&o| if o { 0 } else { u32::MAX })
+        .collect();
+    let mut queue: VecDeque<usize> = (0..w * h).filter(|&k| holes[k]).collect();
+    // Per hole: [near DoLP sum, near count, far DoLP sum, far count].
+    let mut rings = vec![[0.0f64; 4]; n + 1];
+    while let Some(k) = queue.pop_front() {
+        if dist[k] >= RING_FAR {
+            continue;
+        }
+        let (x, y) = (k % w, k / w);
+        let neighbours = [
+            (x > 0).then(|| k - 1),
+            (x + 1 < w).then(|| k + 1),
+            (y > 0).then(|| k - w),
+            (y + 1 < h).then(|| k + w),
+        ];
+        for j in neighbours.into_iter().flatten() {
+            if !m[j] || dist[j] != u32::MAX {
+                continue;
+            }
+            dist[j] = dist[k] + 1;
+            owner[j] = owner[k];
+            queue.push_back(j);
+            if cues.valid[j] {
+                let slot = if dist[k] < RING_NEAR { 0 } else { 2 };
+                let r = &mut rings[owner[j] as usize];
+                r[slot] += f64::from(cues.dolp[j]);
+                r[slot + 1] += 1.0;
+            }
+        }
+    }
+    let open_hole: Vec<bool> = rings
+        .iter()
+        .map(|r| r[1] > 0.0 && r[3] > 0.0 && r[0] / r[1] > r[2] / r[3])
+        .collect();
+    Ok((0..w * h)
+        .map(|k| m[k] || (holes[k] && !open_hole[hole_id[k] as usize]))
+        .collect())
+}
+
+/// The 8-connected components of `m` that pass [`has_contour`].
+fn with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let (id, n) = components(m, w, h)?;
+    if n == 0 {
+        return Ok(m.to_vec());
+    }
+    let mask =
+        Gray::from_vec(w, h, m.iter().map(|&b| f32::from(u8::from(b))).collect()).expect("sized");
+    let mut smooth = Gray::new(w, h);
+    gaussian_blur(&mask, &mut smooth, 0, BOUNDARY_SIGMA)?;
+    let (mut gx, mut gy) = (Gray::new(w, h), Gray::new(w, h));
+    sobel(&smooth, &mut gx, 1, 0, 3)?;
+    sobel(&smooth, &mut gy, 0, 1, 3)?;
+    // Per component: Σ ρ cos 4Δ, Σ ρ, Σ ρ².
+    let mut sums = vec![[0.0f64; 3]; n + 1];
+    for k in 0..w * h {
+        if !m[k] || !cues.valid[k] {
+            continue;
+        }
+        // Outward normal = −∇(smoothed mask); a unit ramp gives a Sobel response of 8.
+        let (dx, dy) = (-f64::from(gx.as_slice()[k]), -f64::from(gy.as_slice()[k]));
+        if dx.hypot(dy) / 8.0 < BOUNDARY_GRADIENT {
+            continue;
+        }
+        let normal = image_direction_angle(&cues.frame(k), dx, dy);
+        let rho = f64::from(cues.dolp[k]);
+        let s = &mut sums[id[k] as usize];
+        s[0] += rho * (4.0 * (f64::from(cues.aolp[k]) - normal)).cos();
+        s[1] += rho;
+        s[2] += rho * rho;
+    }
+    let keep: Vec<bool> = sums.iter().map(|s| has_contour(s[0], s[1], s[2])).collect();
+    Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
+}
+
+/// The occluding-contour test of a boundary from `Σ ρ cos 4Δ`, `Σ ρ` and `Σ ρ²` over its
+/// pixels: the weighted mean of `cos 4Δ` exceeds [`CONTOUR_SIGNIFICANCE`] standard
+/// deviations of its value for independent random AoLP (`cos 4Δ` has mean 0 and
+/// variance ½, so the standard deviation is `√(Σρ²/2) / Σρ`).
+pub(crate) fn has_contour(weighted_cos: f64, weight: f64, weight_sq: f64) -> bool {
+    weight > 0.0 && weighted_cos > CONTOUR_SIGNIFICANCE * (0.5 * weight_sq).sqrt()
 }

@@ -419,3 +419,150 @@ fn specular_dominated_sphere_with_diffuse_range_dolp() {
     // would put it near 45°.
     assert!(err < 10.0, "median angular error {err}");
 }
+
+/// A uniform number in `[0, 1)` from a pixel index and a salt (splitmix64).
+fn hash01(k: usize, salt: u64) -> f64 {
+    let mut z = (k as u64).wrapping_add(salt.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Adds polarization noise of DoLP `noise` and uniformly random AoLP to every pixel:
+/// what a depolarizing floor shows after demosaicing, and what hides the small DoLP of
+/// surfaces facing the camera.
+fn add_polarization_noise(scene: &mut Scene, noise: f64) {
+    for (k, s) in scene.stokes.iter_mut().enumerate() {
+        let (rho, angle) = (noise * hash01(k, 1), std::f64::consts::TAU * hash01(k, 2));
+        s[1] += (f64::from(s[0]) * rho * angle.cos()) as f32;
+        s[2] += (f64::from(s[0]) * rho * angle.sin()) as f32;
+    }
+}
+
+/// Foreground IoU of `fg` against `truth` (`true` = object).
+fn mask_iou(fg: &[bool], truth: &[bool]) -> f64 {
+    let inter = fg.iter().zip(truth).filter(|(a, b)| **a && **b).count();
+    let union = fg.iter().zip(truth).filter(|(a, b)| **a || **b).count();
+    inter as f64 / union.max(1) as f64
+}
+
+/// A diffuse sphere on the left of a 96² frame whose floor is a checkerboard of 12-pixel
+/// cells with a dark elliptical cast shadow on the right; everything carries
+/// polarization noise.
+fn sphere_on_textured_floor() -> (Scene, Vec<bool>) {
+    let centre = Vector3::new(-0.6, 0.0, -5.0);
+    let l = light();
+    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.5, |d| {
+        sphere_hit(d, centre, 0.6).map(|n| (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2)))
+    });
+    let mut shadow = vec![false; 96 * 96];
+    for (k, s) in scene.stokes.iter_mut().enumerate() {
+        if scene.normals[k].norm_squared() > 0.0 {
+            continue;
+        }
+        let (x, y) = (k % 96, k / 96);
+        let checker = if (x / 12 + y / 12) % 2 == 0 {
+            1.0
+        } else {
+            0.45
+        };
+        let (dx, dy) = ((x as f64 - 70.0) / 14.0, (y as f64 - 60.0) / 8.0);
+        shadow[k] = dx * dx + dy * dy < 1.0;
+        s[0] *= if shadow[k] { 0.25 * checker } else { checker };
+    }
+    add_polarization_noise(&mut scene, 0.02);
+    (scene, shadow)
+}
+
+#[test]
+fn textured_floor_and_cast_shadow_are_not_coherent_foreground() {
+    let (scene, shadow) = sphere_on_textured_floor();
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let truth: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    // The window (sigma 3) rounds the silhouette by a pixel or two: 0.8 leaves room
+    // for that on a 29-pixel-radius disc, a missed or shadow-merged sphere is far below.
+    let iou = mask_iou(&fg, &truth);
+    assert!(iou > 0.8, "sphere IoU {iou}");
+    let in_shadow = (0..fg.len()).filter(|&k| fg[k] && shadow[k]).count();
+    assert_eq!(in_shadow, 0, "cast-shadow pixels taken as foreground");
+    // Floor pixels more than 3 pixels from the sphere: none may be foreground.
+    let near =
+        crate::local::distance_to_background(&truth.iter().map(|t| !t).collect::<Vec<_>>(), 96, 96);
+    let far_floor = (0..fg.len()).filter(|&k| fg[k] && near[k] > 3.0).count();
+    assert_eq!(far_floor, 0, "floor texture taken as foreground");
+}
+
+/// An annulus with the normal field of a torus facing the camera (tube radius `r`
+/// around a circle of radius `big_r`, both in units of the image-plane slope `d.xy/−d.z`),
+/// diffuse, on a noisy unpolarized background.
+fn torus_scene(big_r: f64, r: f64) -> Scene {
+    let l = light();
+    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.3, |d| {
+        let (u, v) = (d.x / -d.z, d.y / -d.z);
+        let rho = u.hypot(v);
+        let t = (rho - big_r) / r;
+        (t.abs() < 1.0 && rho > 0.0).then(|| {
+            let n = Vector3::new(t * u / rho, t * v / rho, (1.0 - t * t).sqrt());
+            (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2))
+        })
+    });
+    add_polarization_noise(&mut scene, 0.02);
+    scene
+}
+
+#[test]
+fn torus_hole_stays_background() {
+    let scene = torus_scene(0.14, 0.07);
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let truth: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    let centre = 48 * 96 + 48;
+    assert!(!truth[centre]);
+    let hole = (0..fg.len())
+        .filter(|&k| {
+            let (dx, dy) = ((k % 96) as f64 - 47.5, (k / 96) as f64 - 47.5);
+            dx.hypot(dy) < 8.0
+        })
+        .filter(|&k| fg[k])
+        .count();
+    assert_eq!(hole, 0, "pixels of the torus hole taken as foreground");
+    let iou = mask_iou(&fg, &truth);
+    assert!(iou > 0.7, "torus IoU {iou}");
+}
+
+#[test]
+fn sphere_centre_facing_camera_is_filled() {
+    // The centre's diffuse DoLP (< 0.005 within 20 degrees) drowns in the 0.02 noise:
+    // an incoherent hole whose DoLP rises away from it, so it is filled.
+    let mut scene = sphere_scene(96, 1.5);
+    add_polarization_noise(&mut scene, 0.02);
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let truth: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    assert!(fg[48 * 96 + 48], "centre of the sphere");
+    let iou = mask_iou(&fg, &truth);
+    assert!(iou > 0.85, "sphere IoU {iou}");
+}
+
+#[test]
+fn contour_signature_test() {
+    use crate::foreground::has_contour;
+    // 100 boundary pixels of DoLP 0.1: aligned (cos 4Δ = 1) passes, a mean of 0.1
+    // (0.1 / (√(0.5 · 100 · 0.01) / 10) = 1.4 standard deviations) does not.
+    assert!(has_contour(10.0 * 1.0, 10.0, 1.0));
+    assert!(!has_contour(10.0 * 0.1, 10.0, 1.0));
+    assert!(!has_contour(0.0, 0.0, 0.0));
+}
