@@ -5,10 +5,12 @@
 //! first removes most of the upward bias that sensor noise gives a per-pixel DoLP.
 
 use polar_image::Gray;
+use polar_image::quantile;
 use polar_imgproc::{Border, box_filter};
 use polar_sensor::Observation;
+use rayon::prelude::*;
 
-use crate::MaterialError;
+use crate::{CHUNK, MaterialError, par_map};
 
 /// Side of the averaging window (pixels, odd).
 pub const WINDOW: usize = 5;
@@ -47,46 +49,32 @@ impl Features {
         let scale = obs.s0_scale();
         let p = &obs.planes;
         let n = w * h;
-        let valid: Vec<bool> = (0..n)
-            .map(|k| {
-                let s = [p.s0.as_slice()[k], p.s1.as_slice()[k], p.s2.as_slice()[k]];
-                obs.is_valid(k) && s.iter().all(|v| v.is_finite())
-            })
-            .collect();
-        let norm = |src: &Gray<f32>| -> Gray<f32> {
-            let v = src
-                .as_slice()
-                .iter()
-                .zip(&valid)
-                .map(|(&s, &ok)| if ok { s / scale } else { 0.0 })
-                .collect();
-            Gray::from_vec(w, h, v).expect("size of the planes")
+        let (ps0, ps1, ps2) = (p.s0.as_slice(), p.s1.as_slice(), p.s2.as_slice());
+        let valid: Vec<bool> = par_map(n, |k| {
+            obs.is_valid(k) && [ps0[k], ps1[k], ps2[k]].iter().all(|v| v.is_finite())
+        });
+        let plane = |v: Vec<f32>| Gray::from_vec(w, h, v).expect("size of the planes");
+        let mean_w = boxed(&plane(par_map(n, |k| f32::from(u8::from(valid[k])))))?;
+        let mean_w = mean_w.as_slice();
+        let mean = |src: &[f32]| -> Result<Vec<f32>, MaterialError> {
+            let sum = boxed(&plane(par_map(n, |k| {
+                if valid[k] { src[k] / scale } else { 0.0 }
+            })))?;
+            let sum = sum.as_slice();
+            Ok(par_map(n, |k| {
+                if mean_w[k] > 0.0 {
+                    sum[k] / mean_w[k]
+                } else {
+                    0.0
+                }
+            }))
         };
-        let weight = Gray::from_vec(
-            w,
-            h,
-            valid.iter().map(|&v| f32::from(u8::from(v))).collect(),
-        )
-        .expect("size of the planes");
-        let mean_w = boxed(&weight)?;
-        let mean = |g: &Gray<f32>| -> Result<Vec<f32>, MaterialError> {
-            let m = boxed(g)?;
-            Ok(m.as_slice()
-                .iter()
-                .zip(mean_w.as_slice())
-                .map(|(&v, &wt)| if wt > 0.0 { v / wt } else { 0.0 })
-                .collect())
-        };
-        let (s0, s1, s2) = (
-            mean(&norm(&p.s0))?,
-            mean(&norm(&p.s1))?,
-            mean(&norm(&p.s2))?,
-        );
-        let mut dolp = vec![0.0; n];
-        let mut aolp = vec![0.0; n];
-        for k in 0..n {
-            (dolp[k], aolp[k]) = dolp_aolp(s0[k], s1[k], s2[k]);
-        }
+        let (s0, s1, s2) = (mean(ps0)?, mean(ps1)?, mean(ps2)?);
+        let (dolp, aolp) = (0..n)
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .map(|k| dolp_aolp(s0[k], s1[k], s2[k]))
+            .unzip();
         let pixel_noise = pixel_noise(obs, &valid)?;
         Ok(Self {
             width: w,
@@ -128,39 +116,31 @@ fn boxed(src: &Gray<f32>) -> Result<Gray<f32>, MaterialError> {
 /// components `q = S1/S0`, `u = S2/S0` (`sqrt((var q + var u) / 2)` in a 3x3 window).
 fn pixel_noise(obs: &Observation, valid: &[bool]) -> Result<f32, MaterialError> {
     let (w, h) = obs.size();
+    let n = w * h;
     let p = &obs.planes;
-    let ratio = |s: &Gray<f32>| -> Gray<f32> {
-        let v = (0..w * h)
-            .map(|k| {
-                let s0 = p.s0.as_slice()[k];
-                if valid[k] && s0 > 0.0 {
-                    (s.as_slice()[k] / s0).clamp(-1.0, 1.0)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        Gray::from_vec(w, h, v).expect("size of the planes")
-    };
-    let mut var = vec![0.0f32; w * h];
-    for g in [ratio(&p.s1), ratio(&p.s2)] {
-        let sq = Gray::from_vec(w, h, g.as_slice().iter().map(|v| v * v).collect())
-            .expect("size of the planes");
+    let s0 = p.s0.as_slice();
+    let plane = |v: Vec<f32>| Gray::from_vec(w, h, v).expect("size of the planes");
+    // Local mean and mean square of `s / S0` over 3x3 windows.
+    let moments = |s: &[f32]| -> Result<(Gray<f32>, Gray<f32>), MaterialError> {
+        let g = plane(par_map(n, |k| {
+            if valid[k] && s0[k] > 0.0 {
+                (s[k] / s0[k]).clamp(-1.0, 1.0)
+            } else {
+                0.0
+            }
+        }));
+        let sq = plane(par_map(n, |k| g.as_slice()[k] * g.as_slice()[k]));
         let (mut m, mut m2) = (Gray::new(w, h), Gray::new(w, h));
         box_filter(&g, &mut m, 3, 3, Border::Reflect101)?;
         box_filter(&sq, &mut m2, 3, 3, Border::Reflect101)?;
-        for (k, v) in var.iter_mut().enumerate() {
-            let mu = m.as_slice()[k];
-            *v += (m2.as_slice()[k] - mu * mu).max(0.0) * 9.0 / 8.0;
-        }
-    }
-    let mut sd: Vec<f32> = (0..w * h)
-        .filter(|&k| valid[k])
-        .map(|k| (0.5 * var[k]).sqrt())
-        .collect();
-    if sd.is_empty() {
-        return Ok(0.0);
-    }
-    let mid = sd.len() / 2;
-    Ok(*sd.select_nth_unstable_by(mid, f32::total_cmp).1)
+        Ok((m, m2))
+    };
+    let (q, u) = (moments(p.s1.as_slice())?, moments(p.s2.as_slice())?);
+    let var = |(m, m2): &(Gray<f32>, Gray<f32>), k: usize| {
+        let mu = m.as_slice()[k];
+        (m2.as_slice()[k] - mu * mu).max(0.0) * 9.0 / 8.0
+    };
+    let sd: Vec<f32> = par_map(n, |k| (0.5 * (var(&q, k) + var(&u, k))).sqrt());
+    let valid_sd = (0..n).filter(|&k| valid[k]).map(|k| sd[k]);
+    Ok(quantile(valid_sd, 0.5).unwrap_or(0.0))
 }
