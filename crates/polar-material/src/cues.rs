@@ -59,7 +59,7 @@ pub fn from_normals(
                 return unknown;
             }
             let (az, ze) = obs.pixel_frame(x, y).angles(&(v / len));
-            (ze as f32, (2.0 * (f.aolp[k] - az as f32)).sin_cos())
+            (ze as f32, (2.0 * (f.aolp(k) - az as f32)).sin_cos())
         })
         .collect();
     Ok(Cues {
@@ -106,7 +106,7 @@ pub fn from_silhouette(
             }
             // Outward = −∇; image y runs down, the Stokes frame's y_ref up.
             let beta = gy.atan2(-gx);
-            (2.0 * (f.aolp[k] - beta)).sin_cos()
+            (2.0 * (f.aolp(k) - beta)).sin_cos()
         })
         .unzip();
     let zenith = sphere_prior_zenith(fg, regions, w, h);

@@ -10,7 +10,7 @@ use polar_imgproc::{Border, box_filter};
 use polar_sensor::Observation;
 use rayon::prelude::*;
 
-use crate::{CHUNK, MaterialError, par_map};
+use crate::{CHUNK, MaterialError, par_fill, par_map};
 
 /// Side of the averaging window (pixels, odd).
 pub const WINDOW: usize = 5;
@@ -30,8 +30,6 @@ pub struct Features {
     pub s2: Vec<f32>,
     /// DoLP of the windowed Stokes vector, in `[0, 1]` (0 where undefined).
     pub dolp: Vec<f32>,
-    /// AoLP of the windowed Stokes vector, in `[0, π)` (0 where undefined).
-    pub aolp: Vec<f32>,
     /// `true` where the pixel itself is valid (neither saturated nor dark).
     pub valid: Vec<bool>,
     /// Robust DoLP noise level of one raw pixel: the median over valid pixels of the local
@@ -53,28 +51,24 @@ impl Features {
         let valid: Vec<bool> = par_map(n, |k| {
             obs.is_valid(k) && [ps0[k], ps1[k], ps2[k]].iter().all(|v| v.is_finite())
         });
-        let plane = |v: Vec<f32>| Gray::from_vec(w, h, v).expect("size of the planes");
-        let mean_w = boxed(&plane(par_map(n, |k| f32::from(u8::from(valid[k])))))?;
+        let mut src = Gray::from_vec(w, h, par_map(n, |k| f32::from(u8::from(valid[k]))))
+            .expect("size of the planes");
+        let mean_w = boxed(&src)?;
         let mean_w = mean_w.as_slice();
-        let mean = |src: &[f32]| -> Result<Vec<f32>, MaterialError> {
-            let sum = boxed(&plane(par_map(n, |k| {
-                if valid[k] { src[k] / scale } else { 0.0 }
-            })))?;
-            let sum = sum.as_slice();
-            Ok(par_map(n, |k| {
-                if mean_w[k] > 0.0 {
-                    sum[k] / mean_w[k]
-                } else {
-                    0.0
-                }
-            }))
+        // Windowed mean of `plane / scale` over the valid pixels; `src` is scratch.
+        let mut mean = |plane: &[f32]| -> Result<Vec<f32>, MaterialError> {
+            par_fill(src.as_mut_slice(), |k| {
+                if valid[k] { plane[k] / scale } else { 0.0 }
+            });
+            let mut sum = boxed(&src)?.into_vec();
+            sum.par_iter_mut()
+                .zip(mean_w)
+                .with_min_len(CHUNK)
+                .for_each(|(v, &wt)| *v = if wt > 0.0 { *v / wt } else { 0.0 });
+            Ok(sum)
         };
         let (s0, s1, s2) = (mean(ps0)?, mean(ps1)?, mean(ps2)?);
-        let (dolp, aolp) = (0..n)
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .map(|k| dolp_aolp(s0[k], s1[k], s2[k]))
-            .unzip();
+        let dolp = par_map(n, |k| dolp(s0[k], s1[k], s2[k]));
         let pixel_noise = pixel_noise(obs, &valid)?;
         Ok(Self {
             width: w,
@@ -83,10 +77,15 @@ impl Features {
             s1,
             s2,
             dolp,
-            aolp,
             valid,
             pixel_noise,
         })
+    }
+
+    /// AoLP of the windowed Stokes vector at pixel `k`, in `[0, π)` (0 where undefined);
+    /// on demand, as only the pixels whose phase is measured need it.
+    pub fn aolp(&self, k: usize) -> f32 {
+        aolp(self.s0[k], self.s1[k], self.s2[k])
     }
 
     /// DoLP noise of the windowed DoLP: the raw pixel noise over the window's pixel count.
@@ -95,15 +94,27 @@ impl Features {
     }
 }
 
-/// `(DoLP, AoLP)` of a linear Stokes vector, `(0, 0)` where `s0` is not positive; DoLP is
-/// clamped to `[0, 1]`.
-pub fn dolp_aolp(s0: f32, s1: f32, s2: f32) -> (f32, f32) {
-    if s0.is_nan() || s0 <= 0.0 || !s1.is_finite() || !s2.is_finite() {
-        return (0.0, 0.0);
+/// `true` where a linear Stokes vector has a DoLP and an AoLP: `s0` positive, `s1` and
+/// `s2` finite.
+fn defined(s0: f32, s1: f32, s2: f32) -> bool {
+    s0 > 0.0 && s1.is_finite() && s2.is_finite()
+}
+
+/// DoLP of a linear Stokes vector clamped to `[0, 1]`, 0 where not [`defined`].
+pub fn dolp(s0: f32, s1: f32, s2: f32) -> f32 {
+    if !defined(s0, s1, s2) {
+        return 0.0;
     }
-    let d = (s1.hypot(s2) / s0).min(1.0);
+    (s1.hypot(s2) / s0).min(1.0)
+}
+
+/// AoLP of a linear Stokes vector in `[0, π)`, 0 where not [`defined`].
+pub fn aolp(s0: f32, s1: f32, s2: f32) -> f32 {
+    if !defined(s0, s1, s2) {
+        return 0.0;
+    }
     let a = (0.5 * s2.atan2(s1)).rem_euclid(std::f32::consts::PI);
-    (d, if a.is_finite() { a } else { 0.0 })
+    if a.is_finite() { a } else { 0.0 }
 }
 
 fn boxed(src: &Gray<f32>) -> Result<Gray<f32>, MaterialError> {
@@ -119,28 +130,27 @@ fn pixel_noise(obs: &Observation, valid: &[bool]) -> Result<f32, MaterialError> 
     let n = w * h;
     let p = &obs.planes;
     let s0 = p.s0.as_slice();
-    let plane = |v: Vec<f32>| Gray::from_vec(w, h, v).expect("size of the planes");
-    // Local mean and mean square of `s / S0` over 3x3 windows.
-    let moments = |s: &[f32]| -> Result<(Gray<f32>, Gray<f32>), MaterialError> {
-        let g = plane(par_map(n, |k| {
+    let (mut g, mut sq) = (Gray::new(w, h), Gray::new(w, h));
+    let (mut m, mut m2) = (Gray::new(w, h), Gray::new(w, h));
+    let mut var = vec![0.0f32; n];
+    for s in [p.s1.as_slice(), p.s2.as_slice()] {
+        par_fill(g.as_mut_slice(), |k| {
             if valid[k] && s0[k] > 0.0 {
                 (s[k] / s0[k]).clamp(-1.0, 1.0)
             } else {
                 0.0
             }
-        }));
-        let sq = plane(par_map(n, |k| g.as_slice()[k] * g.as_slice()[k]));
-        let (mut m, mut m2) = (Gray::new(w, h), Gray::new(w, h));
+        });
+        let r = g.as_slice();
+        par_fill(sq.as_mut_slice(), |k| r[k] * r[k]);
         box_filter(&g, &mut m, 3, 3, Border::Reflect101)?;
         box_filter(&sq, &mut m2, 3, 3, Border::Reflect101)?;
-        Ok((m, m2))
-    };
-    let (q, u) = (moments(p.s1.as_slice())?, moments(p.s2.as_slice())?);
-    let var = |(m, m2): &(Gray<f32>, Gray<f32>), k: usize| {
-        let mu = m.as_slice()[k];
-        (m2.as_slice()[k] - mu * mu).max(0.0) * 9.0 / 8.0
-    };
-    let sd: Vec<f32> = par_map(n, |k| (0.5 * (var(&q, k) + var(&u, k))).sqrt());
-    let valid_sd = (0..n).filter(|&k| valid[k]).map(|k| sd[k]);
+        let (m, m2) = (m.as_slice(), m2.as_slice());
+        var.par_iter_mut()
+            .enumerate()
+            .with_min_len(CHUNK)
+            .for_each(|(k, v)| *v += (m2[k] - m[k] * m[k]).max(0.0) * 9.0 / 8.0);
+    }
+    let valid_sd = (0..n).filter(|&k| valid[k]).map(|k| (0.5 * var[k]).sqrt());
     Ok(quantile(valid_sd, 0.5).unwrap_or(0.0))
 }

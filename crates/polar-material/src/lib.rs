@@ -215,6 +215,15 @@ pub(crate) fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -
     (0..n).into_par_iter().with_min_len(CHUNK).map(f).collect()
 }
 
+/// Sets `dst[k] = f(k)` for every index, in parallel (the same values whatever the thread
+/// count); for scratch planes reused across passes.
+pub(crate) fn par_fill<T: Send>(dst: &mut [T], f: impl Fn(usize) -> T + Sync + Send) {
+    dst.par_iter_mut()
+        .enumerate()
+        .with_min_len(CHUNK)
+        .for_each(|(k, d)| *d = f(k));
+}
+
 fn check_size(
     what: &'static str,
     expected: (usize, usize),
