@@ -23,14 +23,14 @@ pub enum MorphShape {
 
 /// One row of a structuring element: kernel row `dy` covers columns `x0 .. x0 + len`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Run {
-    dy: usize,
-    x0: usize,
-    len: usize,
+pub(crate) struct Run {
+    pub(crate) dy: usize,
+    pub(crate) x0: usize,
+    pub(crate) len: usize,
 }
 
 /// The non-empty rows of the structuring element, as `cv::getStructuringElement` builds it.
-fn runs(shape: MorphShape, kw: usize, kh: usize) -> Vec<Run> {
+pub(crate) fn runs(shape: MorphShape, kw: usize, kh: usize) -> Vec<Run> {
     let (c, r) = (kw / 2, kh / 2);
     (0..kh)
         .filter_map(|i| {
@@ -86,7 +86,7 @@ impl Pick for Max {
     }
 }
 
-fn check_kernel(kw: usize, kh: usize) -> Result<(), Error> {
+pub(crate) fn check_kernel(kw: usize, kh: usize) -> Result<(), Error> {
     match (kw, kh) {
         (0, _) | (_, 0) => Err(Error::KernelSize {
             ksize: 0,

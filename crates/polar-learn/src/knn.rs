@@ -77,6 +77,7 @@ impl<const D: usize> Knn<D> {
             .tree
             .query(&z)
             .nearest_n::<SquaredEuclidean<f32>>(self.k)
+            .unsorted()
             .execute();
         let hits = found
             .iter()

@@ -313,7 +313,8 @@ fn stats(c: &Case) {
         .iter()
         .map(|&v| v == 1 || v == 2)
         .collect();
-    let sil = polar_material::cues::from_silhouette(&f, &fgm).unwrap();
+    let regions = polar_material::Regions::new(&fgm, w, h).unwrap();
+    let sil = polar_material::cues::from_silhouette(&f, &fgm, &regions).unwrap();
     for l in [1u8, 2] {
         let m = Gray::from_vec(
             w,

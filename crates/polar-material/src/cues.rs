@@ -13,9 +13,10 @@ use polar_image::{Gray, NormalImage};
 use polar_imgproc::gaussian_blur;
 use polar_sensor::Observation;
 
-use crate::MaterialError;
 use crate::features::Features;
+use crate::{CHUNK, MaterialError, Regions, par_map};
 use nalgebra::Vector3;
+use rayon::prelude::*;
 
 /// Per-pixel cues (NaN where unknown).
 #[derive(Clone, Debug)]
@@ -45,24 +46,22 @@ pub fn from_normals(
             got: normals.size(),
         });
     }
-    let n = w * h;
-    let mut phase = vec![f32::NAN; n];
-    let mut phase_sin = vec![f32::NAN; n];
-    let mut zenith = vec![f32::NAN; n];
-    for y in 0..h {
-        for x in 0..w {
-            let k = y * w + x;
+    let unknown = (f32::NAN, (f32::NAN, f32::NAN));
+    let (zenith, (phase_sin, phase)) = (0..w * h)
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
             let [a, b, c] = *normals.pixel(x, y);
             let v = Vector3::new(f64::from(a), f64::from(b), f64::from(c));
             let len = v.norm();
             if !len.is_finite() || len <= 0.5 {
-                continue;
+                return unknown;
             }
             let (az, ze) = obs.pixel_frame(x, y).angles(&(v / len));
-            zenith[k] = ze as f32;
-            (phase_sin[k], phase[k]) = (2.0 * (f.aolp[k] - az as f32)).sin_cos();
-        }
-    }
+            (ze as f32, (2.0 * (f.aolp(k) - az as f32)).sin_cos())
+        })
+        .collect();
     Ok(Cues {
         phase,
         phase_sin,
@@ -78,35 +77,39 @@ pub const BAND: usize = 3;
 /// inside the boundary; zenith from a sphere prior: a pixel at distance `d` from the
 /// silhouette of a region whose largest such distance is `R` sees `sin θ = 1 − d/R`
 /// (exact for a sphere, a rough guess for other convex shapes).
-pub fn from_silhouette(f: &Features, fg: &[bool]) -> Result<Cues, MaterialError> {
+pub fn from_silhouette(
+    f: &Features,
+    fg: &[bool],
+    regions: &Regions,
+) -> Result<Cues, MaterialError> {
     let (w, h) = (f.width, f.height);
-    let n = w * h;
-    let m = Gray::from_vec(w, h, fg.iter().map(|&b| f32::from(u8::from(b))).collect())
-        .expect("mask size");
+    let m =
+        Gray::from_vec(w, h, par_map(w * h, |k| f32::from(u8::from(fg[k])))).expect("mask size");
     let mut blur = Gray::new(w, h);
     let ks = 2 * BAND + 1;
     gaussian_blur(&m, &mut blur, ks, BAND as f64 * 0.6)?;
     let b = blur.as_slice();
-    let mut phase = vec![f32::NAN; n];
-    let mut phase_sin = vec![f32::NAN; n];
-    for y in 1..h.saturating_sub(1) {
-        for x in 1..w.saturating_sub(1) {
-            let k = y * w + x;
-            // Inside the object and within the blur's reach of its edge.
-            if !fg[k] || b[k] > 0.98 {
-                continue;
+    let unknown = (f32::NAN, f32::NAN);
+    let (phase_sin, phase) = (0..w * h)
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            // Inside the object, off the image border and within the blur's reach of its edge.
+            if x == 0 || y == 0 || x + 1 >= w || y + 1 >= h || !fg[k] || b[k] > 0.98 {
+                return unknown;
             }
             let gx = b[k + 1] - b[k - 1];
             let gy = b[k + w] - b[k - w];
             if gx.hypot(gy) < 1e-3 {
-                continue;
+                return unknown;
             }
             // Outward = −∇; image y runs down, the Stokes frame's y_ref up.
             let beta = gy.atan2(-gx);
-            (phase_sin[k], phase[k]) = (2.0 * (f.aolp[k] - beta)).sin_cos();
-        }
-    }
-    let zenith = sphere_prior_zenith(fg, w, h)?;
+            (2.0 * (f.aolp(k) - beta)).sin_cos()
+        })
+        .unzip();
+    let zenith = sphere_prior_zenith(fg, regions, w, h);
     Ok(Cues {
         phase,
         phase_sin,
@@ -116,25 +119,23 @@ pub fn from_silhouette(f: &Features, fg: &[bool]) -> Result<Cues, MaterialError>
 }
 
 /// Zenith of the sphere prior (NaN outside `fg`), from the chamfer distance to the
-/// nearest pixel outside `fg` (or outside the image) and its maximum per component.
-fn sphere_prior_zenith(fg: &[bool], w: usize, h: usize) -> Result<Vec<f32>, MaterialError> {
+/// nearest pixel outside `fg` (or outside the image) and its maximum per region.
+fn sphere_prior_zenith(fg: &[bool], regions: &Regions, w: usize, h: usize) -> Vec<f32> {
     let d = chamfer_distance(fg, w, h);
-    let (lab, n) = polar_imgproc::mask::components(fg, w, h)?;
-    let mut rmax = vec![0.0f32; n + 1];
+    let lab = &regions.labels;
+    let mut rmax = vec![0.0f32; regions.count + 1];
     for (k, &l) in lab.iter().enumerate() {
         rmax[l as usize] = rmax[l as usize].max(d[k]);
     }
-    Ok((0..w * h)
-        .map(|k| {
-            let r = rmax[lab[k] as usize];
-            if !fg[k] || r <= 0.0 {
-                return f32::NAN;
-            }
-            // The outermost pixel centre lies half a pixel inside the silhouette.
-            let s = (1.0 - (d[k] - 0.5).max(0.0) / r).clamp(0.0, 1.0);
-            s.asin()
-        })
-        .collect())
+    par_map(w * h, |k| {
+        let r = rmax[lab[k] as usize];
+        if !fg[k] || r <= 0.0 {
+            return f32::NAN;
+        }
+        // The outermost pixel centre lies half a pixel inside the silhouette.
+        let s = (1.0 - (d[k] - 0.5).max(0.0) / r).clamp(0.0, 1.0);
+        s.asin()
+    })
 }
 
 /// Two-pass 3-4 chamfer distance (Borgefors 1986) in pixels from each `fg` pixel to the

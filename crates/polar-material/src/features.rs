@@ -5,10 +5,12 @@
 //! first removes most of the upward bias that sensor noise gives a per-pixel DoLP.
 
 use polar_image::Gray;
+use polar_image::quantile;
 use polar_imgproc::{Border, box_filter};
 use polar_sensor::Observation;
+use rayon::prelude::*;
 
-use crate::MaterialError;
+use crate::{CHUNK, MaterialError, par_fill, par_map};
 
 /// Side of the averaging window (pixels, odd).
 pub const WINDOW: usize = 5;
@@ -28,8 +30,6 @@ pub struct Features {
     pub s2: Vec<f32>,
     /// DoLP of the windowed Stokes vector, in `[0, 1]` (0 where undefined).
     pub dolp: Vec<f32>,
-    /// AoLP of the windowed Stokes vector, in `[0, π)` (0 where undefined).
-    pub aolp: Vec<f32>,
     /// `true` where the pixel itself is valid (neither saturated nor dark).
     pub valid: Vec<bool>,
     /// Robust DoLP noise level of one raw pixel: the median over valid pixels of the local
@@ -47,46 +47,28 @@ impl Features {
         let scale = obs.s0_scale();
         let p = &obs.planes;
         let n = w * h;
-        let valid: Vec<bool> = (0..n)
-            .map(|k| {
-                let s = [p.s0.as_slice()[k], p.s1.as_slice()[k], p.s2.as_slice()[k]];
-                obs.is_valid(k) && s.iter().all(|v| v.is_finite())
-            })
-            .collect();
-        let norm = |src: &Gray<f32>| -> Gray<f32> {
-            let v = src
-                .as_slice()
-                .iter()
-                .zip(&valid)
-                .map(|(&s, &ok)| if ok { s / scale } else { 0.0 })
-                .collect();
-            Gray::from_vec(w, h, v).expect("size of the planes")
+        let (ps0, ps1, ps2) = (p.s0.as_slice(), p.s1.as_slice(), p.s2.as_slice());
+        let valid: Vec<bool> = par_map(n, |k| {
+            obs.is_valid(k) && [ps0[k], ps1[k], ps2[k]].iter().all(|v| v.is_finite())
+        });
+        let mut src = Gray::from_vec(w, h, par_map(n, |k| f32::from(u8::from(valid[k]))))
+            .expect("size of the planes");
+        let mean_w = boxed(&src)?;
+        let mean_w = mean_w.as_slice();
+        // Windowed mean of `plane / scale` over the valid pixels; `src` is scratch.
+        let mut mean = |plane: &[f32]| -> Result<Vec<f32>, MaterialError> {
+            par_fill(src.as_mut_slice(), |k| {
+                if valid[k] { plane[k] / scale } else { 0.0 }
+            });
+            let mut sum = boxed(&src)?.into_vec();
+            sum.par_iter_mut()
+                .zip(mean_w)
+                .with_min_len(CHUNK)
+                .for_each(|(v, &wt)| *v = if wt > 0.0 { *v / wt } else { 0.0 });
+            Ok(sum)
         };
-        let weight = Gray::from_vec(
-            w,
-            h,
-            valid.iter().map(|&v| f32::from(u8::from(v))).collect(),
-        )
-        .expect("size of the planes");
-        let mean_w = boxed(&weight)?;
-        let mean = |g: &Gray<f32>| -> Result<Vec<f32>, MaterialError> {
-            let m = boxed(g)?;
-            Ok(m.as_slice()
-                .iter()
-                .zip(mean_w.as_slice())
-                .map(|(&v, &wt)| if wt > 0.0 { v / wt } else { 0.0 })
-                .collect())
-        };
-        let (s0, s1, s2) = (
-            mean(&norm(&p.s0))?,
-            mean(&norm(&p.s1))?,
-            mean(&norm(&p.s2))?,
-        );
-        let mut dolp = vec![0.0; n];
-        let mut aolp = vec![0.0; n];
-        for k in 0..n {
-            (dolp[k], aolp[k]) = dolp_aolp(s0[k], s1[k], s2[k]);
-        }
+        let (s0, s1, s2) = (mean(ps0)?, mean(ps1)?, mean(ps2)?);
+        let dolp = par_map(n, |k| dolp(s0[k], s1[k], s2[k]));
         let pixel_noise = pixel_noise(obs, &valid)?;
         Ok(Self {
             width: w,
@@ -95,10 +77,15 @@ impl Features {
             s1,
             s2,
             dolp,
-            aolp,
             valid,
             pixel_noise,
         })
+    }
+
+    /// AoLP of the windowed Stokes vector at pixel `k`, in `[0, π)` (0 where undefined);
+    /// on demand, as only the pixels whose phase is measured need it.
+    pub fn aolp(&self, k: usize) -> f32 {
+        aolp(self.s0[k], self.s1[k], self.s2[k])
     }
 
     /// DoLP noise of the windowed DoLP: the raw pixel noise over the window's pixel count.
@@ -107,15 +94,27 @@ impl Features {
     }
 }
 
-/// `(DoLP, AoLP)` of a linear Stokes vector, `(0, 0)` where `s0` is not positive; DoLP is
-/// clamped to `[0, 1]`.
-pub fn dolp_aolp(s0: f32, s1: f32, s2: f32) -> (f32, f32) {
-    if s0.is_nan() || s0 <= 0.0 || !s1.is_finite() || !s2.is_finite() {
-        return (0.0, 0.0);
+/// `true` where a linear Stokes vector has a DoLP and an AoLP: `s0` positive, `s1` and
+/// `s2` finite.
+fn defined(s0: f32, s1: f32, s2: f32) -> bool {
+    s0 > 0.0 && s1.is_finite() && s2.is_finite()
+}
+
+/// DoLP of a linear Stokes vector clamped to `[0, 1]`, 0 where not [`defined`].
+pub fn dolp(s0: f32, s1: f32, s2: f32) -> f32 {
+    if !defined(s0, s1, s2) {
+        return 0.0;
     }
-    let d = (s1.hypot(s2) / s0).min(1.0);
+    (s1.hypot(s2) / s0).min(1.0)
+}
+
+/// AoLP of a linear Stokes vector in `[0, π)`, 0 where not [`defined`].
+pub fn aolp(s0: f32, s1: f32, s2: f32) -> f32 {
+    if !defined(s0, s1, s2) {
+        return 0.0;
+    }
     let a = (0.5 * s2.atan2(s1)).rem_euclid(std::f32::consts::PI);
-    (d, if a.is_finite() { a } else { 0.0 })
+    if a.is_finite() { a } else { 0.0 }
 }
 
 fn boxed(src: &Gray<f32>) -> Result<Gray<f32>, MaterialError> {
@@ -128,39 +127,30 @@ fn boxed(src: &Gray<f32>) -> Result<Gray<f32>, MaterialError> {
 /// components `q = S1/S0`, `u = S2/S0` (`sqrt((var q + var u) / 2)` in a 3x3 window).
 fn pixel_noise(obs: &Observation, valid: &[bool]) -> Result<f32, MaterialError> {
     let (w, h) = obs.size();
+    let n = w * h;
     let p = &obs.planes;
-    let ratio = |s: &Gray<f32>| -> Gray<f32> {
-        let v = (0..w * h)
-            .map(|k| {
-                let s0 = p.s0.as_slice()[k];
-                if valid[k] && s0 > 0.0 {
-                    (s.as_slice()[k] / s0).clamp(-1.0, 1.0)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        Gray::from_vec(w, h, v).expect("size of the planes")
-    };
-    let mut var = vec![0.0f32; w * h];
-    for g in [ratio(&p.s1), ratio(&p.s2)] {
-        let sq = Gray::from_vec(w, h, g.as_slice().iter().map(|v| v * v).collect())
-            .expect("size of the planes");
-        let (mut m, mut m2) = (Gray::new(w, h), Gray::new(w, h));
+    let s0 = p.s0.as_slice();
+    let (mut g, mut sq) = (Gray::new(w, h), Gray::new(w, h));
+    let (mut m, mut m2) = (Gray::new(w, h), Gray::new(w, h));
+    let mut var = vec![0.0f32; n];
+    for s in [p.s1.as_slice(), p.s2.as_slice()] {
+        par_fill(g.as_mut_slice(), |k| {
+            if valid[k] && s0[k] > 0.0 {
+                (s[k] / s0[k]).clamp(-1.0, 1.0)
+            } else {
+                0.0
+            }
+        });
+        let r = g.as_slice();
+        par_fill(sq.as_mut_slice(), |k| r[k] * r[k]);
         box_filter(&g, &mut m, 3, 3, Border::Reflect101)?;
         box_filter(&sq, &mut m2, 3, 3, Border::Reflect101)?;
-        for (k, v) in var.iter_mut().enumerate() {
-            let mu = m.as_slice()[k];
-            *v += (m2.as_slice()[k] - mu * mu).max(0.0) * 9.0 / 8.0;
-        }
+        let (m, m2) = (m.as_slice(), m2.as_slice());
+        var.par_iter_mut()
+            .enumerate()
+            .with_min_len(CHUNK)
+            .for_each(|(k, v)| *v += (m2[k] - m[k] * m[k]).max(0.0) * 9.0 / 8.0);
     }
-    let mut sd: Vec<f32> = (0..w * h)
-        .filter(|&k| valid[k])
-        .map(|k| (0.5 * var[k]).sqrt())
-        .collect();
-    if sd.is_empty() {
-        return Ok(0.0);
-    }
-    let mid = sd.len() / 2;
-    Ok(*sd.select_nth_unstable_by(mid, f32::total_cmp).1)
+    let valid_sd = (0..n).filter(|&k| valid[k]).map(|k| (0.5 * var[k]).sqrt());
+    Ok(quantile(valid_sd, 0.5).unwrap_or(0.0))
 }

@@ -21,6 +21,7 @@ use std::sync::Arc;
 use polar_image::{Gray, NormalImage};
 use polar_io::MaterialLabel;
 use polar_sensor::Observation;
+use rayon::prelude::*;
 use thiserror::Error;
 
 /// Label of background pixels (floors, walls, sky), as in `gt/material.png`.
@@ -53,15 +54,36 @@ pub enum MaterialError {
     Imgproc(#[from] polar_imgproc::Error),
 }
 
-/// What every classifier starts from: the features, the object pixels and the cues.
+/// What every classifier starts from: the features, the object pixels, their regions
+/// and the cues.
 #[derive(Clone, Debug)]
 pub struct Prepared {
     /// Per-pixel polarization features.
     pub features: features::Features,
     /// `true` on object pixels (opaque: transparent pixels are cleared).
     pub fg: Vec<bool>,
+    /// The 8-connected regions of `fg`.
+    pub regions: Regions,
     /// Phase and zenith cues, from the normals where given, else from the silhouettes.
     pub cues: cues::Cues,
+}
+
+/// The 8-connected regions of an object mask, labelled once and shared by the cues and
+/// the classifiers' region votes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Regions {
+    /// Per-pixel region id in `1..=count`, 0 outside the mask.
+    pub labels: Vec<u32>,
+    /// Number of regions.
+    pub count: usize,
+}
+
+impl Regions {
+    /// The regions of the `w x h` mask `fg`.
+    pub fn new(fg: &[bool], w: usize, h: usize) -> Result<Self, MaterialError> {
+        let (labels, count) = polar_imgproc::mask::components(fg, w, h)?;
+        Ok(Self { labels, count })
+    }
 }
 
 /// Which classifier decides dielectric versus metal.
@@ -119,29 +141,30 @@ pub fn classify(
         Classifier::Physics => normals,
         Classifier::Knn(_) => None,
     };
-    let Prepared { features, fg, cues } = prepare(obs, normals, foreground, transparent)?;
+    let p = prepare(obs, normals, foreground, transparent)?;
     let smooth = opts.smooth_regions;
     let metal = match clf {
-        Classifier::Physics => rule::metal_probability(&features, &cues, &fg, smooth)?,
-        Classifier::Knn(m) => knn::metal_probability(m, &features, &cues, &fg, smooth)?,
+        Classifier::Physics => rule::metal_probability(&p, smooth)?,
+        Classifier::Knn(m) => knn::metal_probability(m, &p, smooth)?,
     };
     let (w, h) = obs.size();
     let clear = |m: Option<&Gray<u8>>, k: usize| m.is_some_and(|m| m.as_slice()[k] != 0);
-    let mut labels = Vec::with_capacity(w * h);
-    let mut conf = Vec::with_capacity(w * h);
-    for k in 0..w * h {
-        let (l, c) = if clear(transparent, k) {
+    let label = |k: usize| {
+        if clear(transparent, k) {
             (TRANSPARENT, 1.0)
-        } else if !fg[k] {
+        } else if !p.fg[k] {
             (BACKGROUND, 1.0)
         } else if metal[k] > 0.5 {
             (METAL, metal[k])
         } else {
             (DIELECTRIC, 1.0 - metal[k])
-        };
-        labels.push(l);
-        conf.push(c);
-    }
+        }
+    };
+    let (labels, conf) = (0..w * h)
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .map(label)
+        .unzip();
     Ok(MaterialMap {
         labels: Gray::from_vec(w, h, labels).expect("size of the observation"),
         confidence: Gray::from_vec(w, h, conf).expect("size of the observation"),
@@ -149,7 +172,8 @@ pub fn classify(
 }
 
 /// Features, object pixels (`foreground`, else [`foreground::estimate`], minus
-/// `transparent`) and cues (from `normals`, else from the silhouettes) of `obs`.
+/// `transparent`), their regions and cues (from `normals`, else from the silhouettes) of
+/// `obs`.
 pub fn prepare(
     obs: &Observation,
     normals: Option<&NormalImage>,
@@ -169,11 +193,35 @@ pub fn prepare(
             *v &= t == 0;
         }
     }
+    let regions = Regions::new(&fg, size.0, size.1)?;
     let cues = match normals {
         Some(n) => cues::from_normals(obs, &features, n)?,
-        None => cues::from_silhouette(&features, &fg)?,
+        None => cues::from_silhouette(&features, &fg, &regions)?,
     };
-    Ok(Prepared { features, fg, cues })
+    Ok(Prepared {
+        features,
+        fg,
+        regions,
+        cues,
+    })
+}
+
+/// Pixels per rayon task in the element-wise passes (large enough to amortise a task).
+pub(crate) const CHUNK: usize = 1 << 14;
+
+/// `f(k)` for every pixel index `k < n`, computed in parallel, in index order (the same
+/// values whatever the thread count).
+pub(crate) fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    (0..n).into_par_iter().with_min_len(CHUNK).map(f).collect()
+}
+
+/// Sets `dst[k] = f(k)` for every index, in parallel (the same values whatever the thread
+/// count); for scratch planes reused across passes.
+pub(crate) fn par_fill<T: Send>(dst: &mut [T], f: impl Fn(usize) -> T + Sync + Send) {
+    dst.par_iter_mut()
+        .enumerate()
+        .with_min_len(CHUNK)
+        .for_each(|(k, d)| *d = f(k));
 }
 
 fn check_size(

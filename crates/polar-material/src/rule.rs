@@ -13,12 +13,11 @@
 //! A region is dielectric when enough of its pixels pass the Fresnel cue or when its
 //! DoLP-weighted phase leans toward the azimuth; else metal (a metal never shows either).
 
-use crate::MaterialError;
 use crate::cues::Cues;
 use crate::features::Features;
 use crate::fresnel_cues::FresnelTable;
+use crate::{MaterialError, Prepared, Regions, par_map};
 use polar_image::Gray;
-use polar_imgproc::mask::components;
 use polar_imgproc::{Border, box_filter};
 
 /// DoLP margin above the metal envelope before the Fresnel cue fires (rendering or
@@ -108,29 +107,27 @@ impl Tally {
     }
 }
 
-/// Per pixel, the rule's cues of its 8-connected region of `fg` ([0, 0] outside `fg`):
-/// the fraction of the region's valid pixels above the metal envelope and its
+/// Per region id of `regions` (index 0, outside the mask: [0, 0]), the rule's cues of
+/// the region: the fraction of its valid pixels above the metal envelope and its
 /// DoLP-weighted phase, the evidence the rule votes on.
-pub fn region_cues(f: &Features, cues: &Cues, fg: &[bool]) -> Result<Vec<[f32; 2]>, MaterialError> {
+pub fn region_cues(f: &Features, cues: &Cues, regions: &Regions) -> Vec<[f32; 2]> {
+    tallies(f, cues, regions)
+        .iter()
+        .map(Tally::region_cues)
+        .collect()
+}
+
+/// The tallies of every region (index 0, outside the mask, stays empty), summed in raster
+/// order.
+fn tallies(f: &Features, cues: &Cues, regions: &Regions) -> Vec<Tally> {
     let table = FresnelTable::new();
-    let (lab, count) = components(fg, f.width, f.height)?;
-    let mut t = vec![Tally::default(); count + 1];
-    for (k, &l) in lab.iter().enumerate() {
+    let mut t = vec![Tally::default(); regions.count + 1];
+    for (k, &l) in regions.labels.iter().enumerate() {
         if l != 0 {
             t[l as usize].add(f, cues, &table, k);
         }
     }
-    let per_region: Vec<[f32; 2]> = t.iter().map(Tally::region_cues).collect();
-    Ok(lab
-        .iter()
-        .map(|&l| {
-            if l != 0 {
-                per_region[l as usize]
-            } else {
-                [0.0; 2]
-            }
-        })
-        .collect())
+    t
 }
 
 /// Probability of metal from a dielectric score.
@@ -138,70 +135,53 @@ fn metal_from(score: f32) -> f32 {
     1.0 / (1.0 + (2.0 * score.clamp(-10.0, 10.0)).exp())
 }
 
-/// Probability of metal per pixel (0.5 outside `fg`). With `smooth`, each 8-connected
-/// region of `fg` gets one value from its tallies; else each pixel from the tallies of
-/// the `fg` pixels in a [`crate::features::WINDOW`]² window around it.
-pub fn metal_probability(
-    f: &Features,
-    cues: &Cues,
-    fg: &[bool],
-    smooth: bool,
-) -> Result<Vec<f32>, MaterialError> {
+/// Probability of metal per pixel (0.5 outside the object mask). With `smooth`, each
+/// region gets one value from its tallies; else each pixel from the tallies of the object
+/// pixels in a [`crate::features::WINDOW`]² window around it.
+pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, MaterialError> {
+    let (f, cues, fg) = (&p.features, &p.cues, &p.fg);
+    if smooth {
+        let metal: Vec<f32> = tallies(f, cues, &p.regions)
+            .iter()
+            .map(|t| metal_from(t.score()))
+            .collect();
+        let lab = &p.regions.labels;
+        return Ok(par_map(fg.len(), |k| {
+            if fg[k] { metal[lab[k] as usize] } else { 0.5 }
+        }));
+    }
     let table = FresnelTable::new();
     let (w, h) = (f.width, f.height);
-    let n = w * h;
-    if smooth {
-        let (lab, count) = components(fg, w, h)?;
-        let mut t = vec![Tally::default(); count + 1];
-        for k in 0..n {
-            if lab[k] != 0 {
-                t[lab[k] as usize].add(f, cues, &table, k);
-            }
-        }
-        return Ok((0..n)
-            .map(|k| {
-                if fg[k] {
-                    metal_from(t[lab[k] as usize].score())
-                } else {
-                    0.5
-                }
-            })
-            .collect());
-    }
-    let mut planes = [
-        vec![0.0f32; n],
-        vec![0.0f32; n],
-        vec![0.0f32; n],
-        vec![0.0f32; n],
-    ];
-    for j in 0..n {
+    let tally: Vec<Tally> = par_map(w * h, |j| {
+        let mut t = Tally::default();
         if fg[j] {
-            let mut t = Tally::default();
             t.add(f, cues, &table, j);
-            [planes[0][j], planes[1][j], planes[2][j], planes[3][j]] =
-                [t.valid, t.over, t.rho_phase, t.rho];
         }
-    }
-    let k = crate::features::WINDOW;
-    let mut sums = Vec::with_capacity(4);
-    for p in planes {
-        let src = Gray::from_vec(w, h, p).expect("size");
+        t
+    });
+    let plane = |v: fn(&Tally) -> f32| -> Result<Vec<f32>, MaterialError> {
+        let src = Gray::from_vec(w, h, par_map(w * h, |j| v(&tally[j]))).expect("size");
         let mut dst = Gray::new(w, h);
+        let k = crate::features::WINDOW;
         box_filter(&src, &mut dst, k, k, Border::Reflect101)?;
-        sums.push(dst.into_vec());
-    }
-    Ok((0..n)
-        .map(|j| {
-            if !fg[j] {
-                return 0.5;
-            }
-            let t = Tally {
-                valid: sums[0][j],
-                over: sums[1][j],
-                rho_phase: sums[2][j],
-                rho: sums[3][j],
-            };
-            metal_from(t.score())
-        })
-        .collect())
+        Ok(dst.into_vec())
+    };
+    let sums = [
+        plane(|t| t.valid)?,
+        plane(|t| t.over)?,
+        plane(|t| t.rho_phase)?,
+        plane(|t| t.rho)?,
+    ];
+    Ok(par_map(w * h, |j| {
+        if !fg[j] {
+            return 0.5;
+        }
+        let t = Tally {
+            valid: sums[0][j],
+            over: sums[1][j],
+            rho_phase: sums[2][j],
+            rho: sums[3][j],
+        };
+        metal_from(t.score())
+    }))
 }

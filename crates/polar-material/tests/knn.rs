@@ -43,10 +43,7 @@ fn features_are_scale_invariant_times_7() {
     let (obs, _, _) = scene([Surface::Specular(1.5, 0.0), Surface::Diffuse(1.4)]);
     let features = |o: &Observation| {
         let p = prepare(o, None, None, None).unwrap();
-        (
-            knn::pixel_features(&p.features, &p.cues, &p.fg).unwrap(),
-            p.fg,
-        )
+        (knn::pixel_features(&p).unwrap(), p.fg)
     };
     let (a, fa) = features(&obs);
     let (b, fb) = features(&scaled(&obs, 7.0));
@@ -109,4 +106,53 @@ fn builtin_model_matches_the_feature_list() {
     assert_eq!(h.features, knn::FEATURES);
     assert_eq!(h.classes, knn::CLASSES);
     assert!(h.points >= 1000 && h.summary.samples > 0, "{h:?}");
+}
+
+/// The scene tiled `n x n`: frames large enough for several rayon tasks per pass and for
+/// the kNN's query grid (stride above 1).
+fn tiled(obs: &Observation, n: usize) -> Observation {
+    let s = obs.planes.linear_stokes();
+    let (w, h) = s.size();
+    let mut big = polar_image::LinearStokesImage::new(w * n, h * n);
+    for y in 0..h * n {
+        for x in 0..w * n {
+            big.pixels_mut()[y * w * n + x] = s.pixels()[(y % h) * w + x % w];
+        }
+    }
+    Observation::new(
+        StokesPlanes::from_linear_stokes(&big),
+        CameraModel::Orthographic,
+    )
+}
+
+/// Both classifiers give bit-identical labels and confidences on 1 and 3 threads (the
+/// parallel passes split work, never a sum), with and without region smoothing.
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let (obs, _, _) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+    let obs = tiled(&obs, 6);
+    let knn = KnnClassifier::from_bytes(knn::BUILTIN_MODEL, Path::new("builtin")).unwrap();
+    let run = |threads: usize, clf: &Classifier, smooth_regions: bool| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let opts = MaterialOptions { smooth_regions };
+        let m = pool.install(|| classify(&obs, None, None, None, clf, &opts).unwrap());
+        let bits: Vec<u32> = m
+            .confidence
+            .as_slice()
+            .iter()
+            .map(|v| v.to_bits())
+            .collect();
+        (m.labels, bits)
+    };
+    for clf in [Classifier::Physics, Classifier::Knn(Arc::new(knn))] {
+        for smooth in [true, false] {
+            let one = run(1, &clf, smooth);
+            assert_eq!(one, run(3, &clf, smooth), "{clf:?} smooth {smooth}");
+            // Not a trivial frame: both spheres are object pixels.
+            assert!(one.0.as_slice().iter().filter(|&&l| l != 0).count() > 20_000);
+        }
+    }
 }
