@@ -191,18 +191,21 @@ impl Blocks {
             input.s1.as_slice(),
             input.s2.as_slice(),
         );
-        for y in 0..h {
-            for x in 0..w {
-                let k = y * w + x;
-                if input.valid[k] {
-                    let a = &mut acc[(y / b) * gw + x / b];
-                    a[0] += f64::from(s0[k]);
-                    a[1] += f64::from(s1[k]);
-                    a[2] += f64::from(s2[k]);
-                    a[3] += 1.0;
+        // One block row per task; within a block the sums run in row-major order.
+        acc.par_chunks_mut(gw).enumerate().for_each(|(by, accs)| {
+            for y in by * b..((by + 1) * b).min(h) {
+                for x in 0..w {
+                    let k = y * w + x;
+                    if input.valid[k] {
+                        let a = &mut accs[x / b];
+                        a[0] += f64::from(s0[k]);
+                        a[1] += f64::from(s1[k]);
+                        a[2] += f64::from(s2[k]);
+                        a[3] += 1.0;
+                    }
                 }
             }
-        }
+        });
         let mut out = Self {
             s0: vec![],
             s1: vec![],

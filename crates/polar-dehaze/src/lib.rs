@@ -33,6 +33,7 @@ use std::str::FromStr;
 
 use polar_image::Gray;
 use polar_sensor::Observation;
+use rayon::prelude::*;
 use thiserror::Error;
 
 pub use airlight::AirlightEstimate;
@@ -269,11 +270,15 @@ fn finish(
     let scale = input.scale;
     let radiance: Vec<f32> = s0
         .as_slice()
-        .iter()
+        .par_iter()
         .zip(t.as_slice())
         .map(|(&i, &t)| (((i - a) / t + a).max(0.0)) * scale)
         .collect();
-    let depth: Vec<f32> = t.as_slice().iter().map(|&t| (-t.ln()).max(0.0)).collect();
+    let depth: Vec<f32> = t
+        .as_slice()
+        .par_iter()
+        .map(|&t| (-t.ln()).max(0.0))
+        .collect();
     Dehazed {
         radiance: Gray::from_vec(w, h, radiance).expect("size matches"),
         depth: Gray::from_vec(w, h, depth).expect("size matches"),

@@ -9,6 +9,7 @@
 //! guided filter would bias its local means (towards 0.5 where the truth is 0 or 1).
 
 use polar_image::Gray;
+use rayon::prelude::*;
 
 use crate::airlight::{self, AirlightEstimate};
 use crate::prep::Normalized;
@@ -38,6 +39,7 @@ pub fn transmission(input: &Normalized, opts: &DehazeOptions) -> Result<RawEstim
     let proj = est.field.project(&input.s1, &input.s2);
     let p_inf = polarized_infinity(est, w, h);
     let t: Vec<f32> = (0..w * h)
+        .into_par_iter()
         .map(|k| {
             if input.valid[k] {
                 1.0 - proj.as_slice()[k] / p_inf[k]
@@ -61,6 +63,7 @@ fn polarized_infinity(est: &AirlightEstimate, w: usize, h: usize) -> Vec<f32> {
     let n = w * h;
     match &est.sky {
         Some(sky) => (0..n)
+            .into_par_iter()
             .map(|k| {
                 let (x, y) = (
                     airlight::norm_coord(k % w, w),

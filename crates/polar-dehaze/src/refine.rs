@@ -31,7 +31,7 @@ pub fn refine(
         t = filled;
     }
     let t_min = opts.t_min;
-    t.as_mut_slice().iter_mut().for_each(|v| {
+    t.as_mut_slice().par_iter_mut().for_each(|v| {
         *v = if v.is_finite() {
             v.clamp(t_min, 1.0)
         } else {
@@ -45,7 +45,7 @@ pub fn refine(
 /// (normalised convolution), widening the window until some are known; all unknown gives 1.
 pub fn fill_unknown(raw: &Gray<f32>, radius: usize) -> Result<Gray<f32>, DehazeError> {
     let (w, h) = raw.size();
-    let known: Vec<bool> = raw.as_slice().iter().map(|v| v.is_finite()).collect();
+    let known: Vec<bool> = raw.as_slice().par_iter().map(|v| v.is_finite()).collect();
     if known.iter().all(|&k| k) {
         return Ok(raw.clone());
     }

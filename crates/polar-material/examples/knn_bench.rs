@@ -4,6 +4,7 @@
 //!
 //! `cargo run --release -p polar-material --example knn_bench -- SAMPLE_DIR [MODEL]`
 //! (MODEL: a model file; default the shipped one). Set RAYON_NUM_THREADS=2 for 2 cores.
+//! Built with the binaries' allocator (mimalloc), as the times are what the CLI sees.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -14,6 +15,10 @@ use polar_material::knn::{BUILTIN_MODEL, KnnClassifier};
 use polar_material::{Classifier, MaterialOptions, classify};
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::{Observation, StokesPlanes};
+
+/// The binaries' allocator, so the times are what `polar-vision run` sees.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 const SIDE: usize = 1024;
 
