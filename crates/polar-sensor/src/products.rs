@@ -216,16 +216,7 @@ pub fn stokes_planes_rgb_into<T: MosaicSample>(
 ) -> Result<(), SensorError> {
     let (w, h) = raw.size();
     MosaicPattern::Rgb.check_size(w, h)?;
-    let (ow, oh) = method.output_size(w, h);
-    if out.size() != (ow, oh) {
-        let (got_width, got_height) = out.size();
-        return Err(SensorError::OutputSize {
-            width: ow,
-            height: oh,
-            got_width,
-            got_height,
-        });
-    }
+    check_output_size(method.output_size(w, h), out.size())?;
     if method == DemosaicMethod::Bilinear {
         fused_rgb_bilinear(raw.view(), out, Arch::new());
         return Ok(());
@@ -318,6 +309,22 @@ pub fn stokes_planes_from_angles(
     Ok(out)
 }
 
+/// [`SensorError::OutputSize`] unless the caller's planes have the size `method` gives.
+fn check_output_size(
+    (width, height): (usize, usize),
+    (got_width, got_height): (usize, usize),
+) -> Result<(), SensorError> {
+    if (got_width, got_height) == (width, height) {
+        return Ok(());
+    }
+    Err(SensorError::OutputSize {
+        width,
+        height,
+        got_width,
+        got_height,
+    })
+}
+
 /// Raw mosaic -> `S0, S1, S2, DoLP, AoLP`, allocating the output.
 pub fn stokes_planes<T: MosaicSample>(
     raw: &Mosaic<T>,
@@ -339,16 +346,7 @@ pub fn stokes_planes_into<T: MosaicSample>(
 ) -> Result<(), SensorError> {
     let (w, h) = raw.size();
     check_mosaic_size(w, h)?;
-    let (ow, oh) = method.output_size(w, h);
-    if out.size() != (ow, oh) {
-        let (got_width, got_height) = out.size();
-        return Err(SensorError::OutputSize {
-            width: ow,
-            height: oh,
-            got_width,
-            got_height,
-        });
-    }
+    check_output_size(method.output_size(w, h), out.size())?;
     match method {
         DemosaicMethod::Bilinear if w >= 4 && h >= 4 => {
             fused_bilinear(raw.view(), out, Arch::new())
