@@ -290,3 +290,40 @@ fn run_outputs_are_identical_whatever_the_threads() {
         );
     }
 }
+
+/// A colour camera's sample: the ci shape sample's grey-world mosaic read as an IMX250MYR
+/// one (`sensor.pattern` of a meta.json with no other key; the polarizer angles sit where
+/// they do in the mono layout, so the same frame is a valid colour mosaic of a grey
+/// scene). `run` gives every task the luminance, writes the nine colour Stokes channels and
+/// scores shape from polarization within 10° of the mono reading: each colour is sampled
+/// every 4 pixels instead of every 2, which blurs edges on these 64x64 frames, but a
+/// task that read one colour plane or the wrong angles would be off by far more.
+#[test]
+fn run_on_a_colour_sample_takes_the_luminance() {
+    let mono = standard_ci().join("sfp-00001");
+    let dir = tempfile::tempdir().unwrap();
+    let colour = dir.path().join("sfp-colour");
+    polar_datagen::store::copy_dir(&mono, &colour).unwrap();
+    std::fs::write(
+        colour.join(files::META),
+        r#"{"sensor": {"pattern": "rgb"}}"#,
+    )
+    .unwrap();
+    let mean_error = |sample: &std::path::Path, out: &std::path::Path| {
+        let ok = vision(&["run", arg(sample), "--out", arg(out), "--tasks", "sfp"]);
+        assert_eq!(ok, Ok(true), "run on {}", sample.display());
+        let m = json(&out.join(vision::METRICS));
+        m["tasks"]["sfp"]["metrics"]["normal"]["mean_deg"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("no sfp normal.mean_deg in {m}"))
+    };
+    let (out_mono, out_colour) = (dir.path().join("mono"), dir.path().join("colour"));
+    let (e_mono, e_colour) = (
+        mean_error(&mono, &out_mono),
+        mean_error(&colour, &out_colour),
+    );
+    eprintln!("sfp on the colour reading: {e_colour:.2} deg, mono {e_mono:.2} deg");
+    assert!((e_colour - e_mono).abs() < 10.0, "{e_colour} vs {e_mono}");
+    let names = polar_io::exr_channel_names(out_colour.join(vision::STOKES)).unwrap();
+    assert_eq!(names.len(), 9, "{names:?}");
+}

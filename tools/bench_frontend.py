@@ -22,8 +22,9 @@ and through polar-sensor's `stokes_planes_rgb_into` (the example with --pattern=
 Whole process (`--process N`): `polar-vision stokes FRAME --out DIR` spawned as a user
 runs it (release build), median of N runs, with the default `residual` and with
 `--demosaic bilinear`, in the same run as polanalyser's chain; reports the split the
-program prints (compute = read + demosaic + products, outputs), the bytes its outputs
-take on disk and its peak resident memory per input pixel (from GNU time).
+program prints (compute = read + demosaic + products, outputs) and its `--timings` stages
+(read, exposure checks, demosaic + products, validity mask, each output file), the bytes its
+outputs take on disk and its peak resident memory per input pixel (from GNU time).
 
 Usage: tools/.venv/bin/python tools/bench_frontend.py [FRAME.png] [--reps N] [--process N] [--no-native]
 """
@@ -84,7 +85,7 @@ def run_process(exe, frame, extra):
     gnu_time = Path("/usr/bin/time")
     with tempfile.TemporaryDirectory() as tmp:
         out, rss_file = Path(tmp) / "out", Path(tmp) / "rss"
-        cmd = [str(exe), "stokes", frame, "--out", str(out), *extra]
+        cmd = [str(exe), "stokes", frame, "--out", str(out), "--timings", *extra]
         if gnu_time.is_file():
             cmd = [str(gnu_time), "-f", "%M", "-o", str(rss_file), *cmd]
         t = time.perf_counter()
@@ -95,7 +96,8 @@ def run_process(exe, frame, extra):
         size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
         peak = int(rss_file.read_text().split()[-1]) * 1024 if rss_file.is_file() else None
     split = re.search(r"in ([0-9.]+) ms, outputs in ([0-9.]+) ms", proc.stderr)
-    return wall, split.groups() if split else ("?", "?"), size, peak
+    stages = re.search(r"^timings: (.*)$", proc.stderr, re.MULTILINE)
+    return wall, split.groups() if split else ("?", "?"), size, peak, stages.group(1) if stages else "?"
 
 
 def process_table(frame, runs, t_py, pixels):
@@ -106,6 +108,7 @@ def process_table(frame, runs, t_py, pixels):
     print(f"Whole process, median of {runs} runs (polanalyser compute {t_py * 1e3:.0f} ms in this run):")
     print(f"| {'command':<44} | {'wall ms':>8} | {'vs polanalyser':>14} | {'compute / outputs ms':>20} | {'MB on disk':>10} | {'peak B/px':>9} |")
     print(f"|{'-' * 46}|{'-' * 10}|{'-' * 16}|{'-' * 22}|{'-' * 12}|{'-' * 11}|")
+    splits = []
     for label, extra in [("stokes (default: residual)", []), ("stokes --demosaic bilinear", ["--demosaic", "bilinear"])]:
         rs = [run_process(exe, frame, extra) for _ in range(runs)]
         wall = statistics.median(r[0] for r in rs)
@@ -116,6 +119,11 @@ def process_table(frame, runs, t_py, pixels):
             f"| {label:<44} | {wall * 1e3:8.0f} | {t_py / wall:13.2f}x | {mid[1][0]:>9} / {mid[1][1]:>8} | "
             f"{mid[2] / 1e6:10.1f} | {peak} |"
         )
+        splits.append((label, mid[4]))
+    print()
+    print("Stages of the median run (--timings; output files are encoded in parallel, so their times overlap):")
+    for label, stages in splits:
+        print(f"- {label}: {stages}")
 
 
 def main():

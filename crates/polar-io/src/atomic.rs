@@ -19,11 +19,23 @@ pub(crate) fn temp_sibling(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()))
 }
 
+/// Whether a write waits until its data is on disk (`fsync`) before it is renamed into place.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Durability {
+    /// Survives a power loss right after the call: for small records a resumable program
+    /// trusts (manifests, model files, eval records).
+    Synced,
+    /// In the page cache only, as any image library writes: for image files, whose folder
+    /// [`crate::StagedDir::commit`] syncs as a whole where that matters.
+    Cached,
+}
+
 /// Writes a file through `write_body`, atomically: the data goes to a temporary sibling that
-/// is renamed onto `path` only after it was written, flushed and synced to disk without
-/// error (so a crash after the rename cannot leave an empty or partial file under `path`).
+/// is renamed onto `path` only after it was written and flushed (and, for [`Durability::Synced`],
+/// synced to disk) without error.
 pub(crate) fn write_file_atomic(
     path: &Path,
+    durability: Durability,
     write_body: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
 ) -> Result<()> {
     let tmp = temp_sibling(path);
@@ -32,10 +44,12 @@ pub(crate) fn write_file_atomic(
         let mut writer = BufWriter::new(file);
         write_body(&mut writer)?;
         writer.flush().map_err(|e| Error::io(path, "output", e))?;
-        writer
-            .get_ref()
-            .sync_all()
-            .map_err(|e| Error::io(path, "output", e))?;
+        if durability == Durability::Synced {
+            writer
+                .get_ref()
+                .sync_all()
+                .map_err(|e| Error::io(path, "output", e))?;
+        }
         std::fs::rename(&tmp, path).map_err(|e| Error::io(path, "output", e))
     })();
     if result.is_err() {
@@ -45,10 +59,10 @@ pub(crate) fn write_file_atomic(
     result
 }
 
-/// Writes `bytes` to `path` atomically (see [`write_file_atomic`]).
+/// Writes `bytes` to `path` atomically and durably (see [`write_file_atomic`]).
 pub fn write_atomic(path: impl AsRef<Path>, bytes: &[u8]) -> Result<()> {
     let path = path.as_ref();
-    write_file_atomic(path, |w| {
+    write_file_atomic(path, Durability::Synced, |w| {
         w.write_all(bytes).map_err(|e| Error::io(path, "output", e))
     })
 }

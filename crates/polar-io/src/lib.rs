@@ -4,7 +4,9 @@
 //! Every reader returns a typed [`Error`] naming the file: missing, truncated or corrupt,
 //! wrong colour type or bit depth, odd mosaic size, missing channel, NaN/Inf where not
 //! allowed, sizes that disagree within a sample. Every writer is atomic (temporary sibling,
-//! then rename), so a crash never leaves a half-written file under the final name.
+//! then rename), so a failed program never leaves a half-written file under the final name.
+//! Small records ([`write_atomic`], [`write_json`]) are also synced to disk before the
+//! rename; images are synced where their folder is committed ([`StagedDir::commit`]).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 

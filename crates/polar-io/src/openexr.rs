@@ -14,7 +14,7 @@ use exr::prelude::{
 };
 use polar_image::{Gray, Image};
 
-use crate::atomic::write_file_atomic;
+use crate::atomic::{Durability, write_file_atomic};
 use crate::error::{Error, Result};
 
 /// Lossless compression of written EXR files. Noisy float data barely deflates, so ZIP
@@ -200,7 +200,7 @@ fn write_image<'c, C: WritableChannels<'c>>(
     path: &Path,
     image: &'c exr::prelude::Image<Layer<C>>,
 ) -> Result<()> {
-    write_file_atomic(path, |writer| {
+    write_file_atomic(path, Durability::Cached, |writer| {
         image
             .write()
             .to_buffered(writer)

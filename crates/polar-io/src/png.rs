@@ -9,7 +9,7 @@ use std::path::Path;
 use polar_image::kind::RawMosaic;
 use polar_image::{Gray, Image, Plain};
 
-use crate::atomic::write_file_atomic;
+use crate::atomic::{Durability, write_file_atomic};
 use crate::error::{Error, Result};
 
 /// Largest decoded image accepted (bytes). Guards against headers that claim absurd sizes.
@@ -374,7 +374,7 @@ fn encode(path: &Path, layout: Layout, mut fill: impl FnMut(usize, &mut [u8])) -
         },
     };
     let mut block = vec![0u8; layout.row_bytes * ROW_BLOCK.min(layout.height)];
-    write_file_atomic(path, |writer| {
+    write_file_atomic(path, Durability::Cached, |writer| {
         let mut encoder = png::Encoder::new(writer, w, h);
         encoder.set_color(layout.color);
         encoder.set_depth(layout.depth);

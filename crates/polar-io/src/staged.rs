@@ -57,10 +57,19 @@ impl StagedDir {
         &self.staging
     }
 
-    /// Moves the staged folder onto the target (the old target, if any, is removed after
-    /// the swap). The staged folder must hold the marker, so that the next run may replace
-    /// it in turn.
-    pub fn commit(mut self) -> Result<PathBuf> {
+    /// Syncs every file and folder of the staged folder to disk, then moves it onto the
+    /// target (the old target, if any, is removed after the swap): after a power loss the
+    /// target is the old set or the whole new one, which a resumable program may trust.
+    /// The staged folder must hold the marker, so that the next run may replace it in turn.
+    pub fn commit(self) -> Result<PathBuf> {
+        sync_tree(&self.staging)?;
+        self.commit_cached()
+    }
+
+    /// [`StagedDir::commit`] without the sync: the swap still protects against the program
+    /// failing, but the files may still be in the page cache only, as any image tool leaves
+    /// its outputs (a power loss right after may lose them).
+    pub fn commit_cached(mut self) -> Result<PathBuf> {
         if !self.staging.join(self.marker).is_file() {
             return Err(Error::io(
                 &self.staging.join(self.marker),
@@ -95,6 +104,26 @@ impl Drop for StagedDir {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
     }
+}
+
+/// `fsync`s every file under `dir`, then `dir` itself (so its entries are on disk too).
+fn sync_tree(dir: &Path) -> Result<()> {
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, "output", e))?;
+    for entry in entries {
+        let path = entry.map_err(|e| Error::io(dir, "output", e))?.path();
+        if path.is_dir() {
+            sync_tree(&path)?;
+        } else {
+            sync_path(&path)?;
+        }
+    }
+    sync_path(dir)
+}
+
+fn sync_path(path: &Path) -> Result<()> {
+    std::fs::File::open(path)
+        .and_then(|f| f.sync_all())
+        .map_err(|e| Error::io(path, "output", e))
 }
 
 /// Refuses a `target` that exists and is not a folder this program may replace: a file, or
@@ -183,6 +212,25 @@ mod tests {
         assert_eq!(names, [MARK, "a.txt"]);
         let leftovers = std::fs::read_dir(&root).unwrap().count();
         assert_eq!(leftovers, 1, "only out/ remains beside it");
+    }
+
+    #[test]
+    fn synced_and_cached_commits_move_nested_folders_whole() {
+        let root = tmp("nested");
+        for (name, synced) in [("synced", true), ("cached", false)] {
+            let out = root.join(name);
+            let s = StagedDir::new(&out, MARK).unwrap();
+            std::fs::create_dir(s.path().join("pictures")).unwrap();
+            std::fs::write(s.path().join("pictures/p.png"), "p").unwrap();
+            std::fs::write(s.path().join(MARK), "").unwrap();
+            if synced {
+                s.commit()
+            } else {
+                s.commit_cached()
+            }
+            .unwrap();
+            assert_eq!(std::fs::read(out.join("pictures/p.png")).unwrap(), b"p");
+        }
     }
 
     #[test]

@@ -13,7 +13,7 @@
 //! selects, which IEEE 754 rounds identically at any vector width, and Rust never
 //! contracts `a * b + c` into an FMA on its own (a test compares the targets).
 
-use polar_image::{Gray, ImageView, LinearStokesImage, PolarizerStack};
+use polar_image::{Gray, Image, ImageView, LinearStokesImage, PolarizerStack};
 use polar_optics::LinearStokesFit;
 use polar_optics::stokes::{imax, imin, linear_stokes_from_quad};
 use pulp::{Arch, Simd, WithSimd};
@@ -163,6 +163,22 @@ impl ColorStokesPlanes {
     /// `(width, height)` of the planes.
     pub fn size(&self) -> (usize, usize) {
         self.colors[0].size()
+    }
+
+    /// DoLP and AoLP of each colour of a colour Stokes image with the channels
+    /// `S0.R, S0.G, S0.B, S1.R, ... S2.B` (e.g. read from a colour `stokes.exr`).
+    pub fn from_rgb_linear_stokes(stokes: &Image<f32, 9>) -> Self {
+        let (w, h) = stokes.size();
+        let colors = std::array::from_fn(|c| {
+            let data = stokes
+                .pixels()
+                .iter()
+                .flat_map(|p| [p[c], p[3 + c], p[6 + c]]);
+            let one = LinearStokesImage::from_vec(w, h, data.collect())
+                .expect("as many pixels as the colour image");
+            StokesPlanes::from_linear_stokes(&one)
+        });
+        Self { colors }
     }
 
     /// Stokes of the luminance `Y = Σ LUMA_REC709[c] · colour c` with its DoLP and AoLP:

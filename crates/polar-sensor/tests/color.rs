@@ -4,7 +4,9 @@
 use polar_optics::stokes::intensity_through_polarizer;
 use polar_sensor::layout::{CHANNEL_ANGLES_DEG, channel_at, color_at};
 use polar_sensor::products::LUMA_REC709;
-use polar_sensor::{DemosaicMethod, Mosaic, SensorError, demosaic_rgb, stokes_planes_rgb};
+use polar_sensor::{
+    ColorStokesPlanes, DemosaicMethod, Mosaic, SensorError, demosaic_rgb, stokes_planes_rgb,
+};
 
 /// The colour mosaic of a per-colour linear Stokes field `stokes(colour, x, y)`, rounded to DN.
 fn colour_mosaic(w: usize, h: usize, stokes: impl Fn(usize, f32, f32) -> [f32; 3]) -> Mosaic<u16> {
@@ -142,4 +144,31 @@ fn colour_mosaic_not_of_whole_tiles_is_an_error() {
             height: 8
         }
     );
+}
+
+/// A colour Stokes image in `stokes.exr`'s channel order (`S0.R, S0.G, S0.B, S1.R, ...`)
+/// gives back each colour's planes exactly: the products are the same f32 formulas on the
+/// same values, so any swap of colours or parameters fails the equality.
+#[test]
+fn colour_stokes_image_gives_each_colours_planes() {
+    let raw = colour_mosaic(24, 16, |c, x, y| {
+        let [s0, s1, s2] = FLAT[c];
+        [s0 + 8.0 * x, s1 - 2.0 * y, s2 + x]
+    });
+    let planes = stokes_planes_rgb(&raw, DemosaicMethod::Bilinear).unwrap();
+    let (w, h) = planes.size();
+    let channels: Vec<&[f32]> = [0, 1, 2]
+        .iter()
+        .flat_map(|&k| {
+            planes
+                .colors
+                .iter()
+                .map(move |p| [&p.s0, &p.s1, &p.s2][k].as_slice())
+        })
+        .collect();
+    let data = (0..w * h)
+        .flat_map(|i| channels.iter().map(move |c| c[i]))
+        .collect();
+    let image = polar_image::Image::<f32, 9>::from_vec(w, h, data).unwrap();
+    assert_eq!(ColorStokesPlanes::from_rgb_linear_stokes(&image), planes);
 }

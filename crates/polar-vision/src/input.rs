@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use clap::{Args, ValueEnum};
 use polar_image::Mosaic;
 use polar_io::files;
-use polar_io::{LINEAR_STOKES_CHANNELS, MosaicPng};
+use polar_io::{LINEAR_STOKES_CHANNELS, MosaicPng, RGB_LINEAR_STOKES_CHANNELS};
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::mask::{count_saturated, validity_mask, validity_mask_rgb};
 use polar_sensor::{
@@ -21,6 +21,7 @@ use polar_sensor::{
 use serde_json::{Map, Value};
 
 use crate::error::CliError;
+use crate::timings::Timings;
 
 /// Options that say how to read the input (shared by `stokes`, `run` and `eval`).
 #[derive(Clone, Debug, Args)]
@@ -64,6 +65,8 @@ pub struct Reading {
     pub colors: Option<ColorStokesPlanes>,
     /// E.g. saturated pixels, which are flagged.
     pub warnings: Vec<String>,
+    /// Wall time of each stage of the reading (`--timings`).
+    pub timings: Timings,
 }
 
 /// Alignment of fewer-bit data in wider PNG samples.
@@ -134,7 +137,8 @@ pub enum InputFile {
     Stokes(PathBuf),
 }
 
-/// Resolves `path` (a PNG or a sample directory) before any work; `source` forces one file.
+/// Resolves `path` (a raw PNG, a Stokes EXR by its `.exr` extension, or a sample
+/// directory) before any work; `source` forces one file.
 pub fn resolve(path: &Path, source: Option<Source>) -> Result<InputFile, CliError> {
     if !path.exists() {
         return Err(polar_io::Error::NotFound {
@@ -143,8 +147,12 @@ pub fn resolve(path: &Path, source: Option<Source>) -> Result<InputFile, CliErro
         .into());
     }
     if !path.is_dir() {
+        let exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
         return match source {
             Some(Source::Stokes) => Ok(InputFile::Stokes(path.to_owned())),
+            None if exr => Ok(InputFile::Stokes(path.to_owned())),
             _ => Ok(InputFile::Raw(path.to_owned())),
         };
     }
@@ -179,24 +187,48 @@ pub fn read_observation(
 pub fn read_input(file: &InputFile, args: &InputArgs) -> Result<Reading, CliError> {
     match file {
         InputFile::Raw(path) => read_raw(path, args),
-        InputFile::Stokes(path) => {
-            let stokes = polar_io::read_exr(path, LINEAR_STOKES_CHANNELS)?;
-            // As for a raw frame with no light: nothing can be computed anywhere.
-            if !stokes
-                .pixels()
-                .iter()
-                .any(|p| p[0] > 0.0 && p[0].is_finite())
-            {
-                return Err(CliError::NoLight(path.to_owned()));
-            }
-            let planes = StokesPlanes::from_linear_stokes(&stokes);
-            Ok(Reading {
-                obs: Observation::new(planes, CameraModel::Orthographic),
-                colors: None,
-                warnings: vec![],
-            })
-        }
+        InputFile::Stokes(path) => read_stokes(path),
     }
+}
+
+/// A Stokes EXR: `S0, S1, S2`, or, without those, a colour one's `S0.R ... S2.B` (as
+/// `stokes --pattern rgb` and Mitsuba 3's RGB modes write), whose observation is the
+/// luminance.
+fn read_stokes(path: &Path) -> Result<Reading, CliError> {
+    let mut timings = Timings::default();
+    let names = polar_io::exr_channel_names(path)?;
+    let has = |want: &[&str]| want.iter().all(|c| names.iter().any(|n| n == c));
+    let colour = !has(&LINEAR_STOKES_CHANNELS) && has(&RGB_LINEAR_STOKES_CHANNELS);
+    let (planes, colors) = if colour {
+        let stokes = timings.time("read stokes.exr", || {
+            polar_io::read_exr(path, RGB_LINEAR_STOKES_CHANNELS)
+        })?;
+        let colors = timings.time("products", || {
+            ColorStokesPlanes::from_rgb_linear_stokes(&stokes)
+        });
+        (colors.luminance(), Some(colors))
+    } else {
+        let stokes = timings.time("read stokes.exr", || {
+            polar_io::read_exr(path, LINEAR_STOKES_CHANNELS)
+        })?;
+        let planes = timings.time("products", || StokesPlanes::from_linear_stokes(&stokes));
+        (planes, None)
+    };
+    // As for a raw frame with no light: nothing can be computed anywhere.
+    if !planes
+        .s0
+        .as_slice()
+        .iter()
+        .any(|&v| v > 0.0 && v.is_finite())
+    {
+        return Err(CliError::NoLight(path.to_owned()));
+    }
+    Ok(Reading {
+        obs: Observation::new(planes, CameraModel::Orthographic),
+        colors,
+        warnings: vec![],
+        timings,
+    })
 }
 
 /// A raw mosaic PNG through `--bit-depth`/`--align`, the exposure checks and the
@@ -207,34 +239,44 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
             .expect("clap restricts the values to 8, 10, 12, 16")
     });
     let pattern = mosaic_pattern(path, args.pattern)?;
-    let png = polar_io::read_mosaic(path)?;
-    let (raw, bits) = significant_bits(path, png, bits, args.align)?;
-    let (w, h) = raw.size();
-    pattern
-        .check_size(w, h)
-        .map_err(|source| CliError::Pattern {
-            path: path.to_owned(),
-            pattern,
-            source,
-        })?;
-    let level = saturation_level(&raw, bits);
-    let warning = check_exposure(path, &raw, bits, level)?;
+    let mut timings = Timings::default();
+    let png = timings.time("read raw.png", || polar_io::read_mosaic(path))?;
+    let (raw, level, warning) = timings.time("exposure checks", || {
+        let (raw, bits) = significant_bits(path, png, bits, args.align)?;
+        let (w, h) = raw.size();
+        pattern
+            .check_size(w, h)
+            .map_err(|source| CliError::Pattern {
+                path: path.to_owned(),
+                pattern,
+                source,
+            })?;
+        let level = saturation_level(&raw, bits);
+        let warning = check_exposure(path, &raw, bits, level)?;
+        Ok::<_, CliError>((raw, level, warning))
+    })?;
+    let demosaic = "demosaic + products";
     let (planes, flags, colors) = match pattern {
         MosaicPattern::Mono => {
-            let planes = stokes_planes(&raw, args.demosaic)?;
-            let flags = validity_mask(&raw, level, args.demosaic, &planes.s0);
+            let planes = timings.time(demosaic, || stokes_planes(&raw, args.demosaic))?;
+            let flags = timings.time("validity mask", || {
+                validity_mask(&raw, level, args.demosaic, &planes.s0)
+            });
             (planes, flags, None)
         }
         MosaicPattern::Rgb => {
-            let colors = stokes_planes_rgb(&raw, args.demosaic)?;
-            let planes = colors.luminance();
-            let flags = validity_mask_rgb(&raw, level, args.demosaic, &planes.s0)?;
+            let colors = timings.time(demosaic, || stokes_planes_rgb(&raw, args.demosaic))?;
+            let planes = timings.time("luminance", || colors.luminance());
+            let flags = timings.time("validity mask", || {
+                validity_mask_rgb(&raw, level, args.demosaic, &planes.s0)
+            })?;
             (planes, flags, Some(colors))
         }
     };
     Ok(Reading {
         obs: Observation::new(planes, CameraModel::Orthographic).with_flags(flags),
         colors,
+        timings,
         warnings: warning.into_iter().collect(),
     })
 }

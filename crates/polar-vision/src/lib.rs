@@ -13,4 +13,5 @@ pub mod run;
 pub mod stokes;
 pub mod task_options;
 pub mod tasks;
+pub mod timings;
 pub mod train;

@@ -25,10 +25,12 @@ pub fn stage(out: &Path) -> Result<StagedDir, CliError> {
     Ok(StagedDir::new(out, vision::MARKER)?)
 }
 
-/// Marks the staged outputs as polar-vision's and moves them onto their folder.
+/// Marks the staged outputs as polar-vision's and moves them onto their folder, without
+/// syncing them to disk first (as OpenCV or Mitsuba leave their outputs): the sync would
+/// take longer than the computation, and a rerun recomputes them.
 pub fn commit(staged: StagedDir) -> Result<(), CliError> {
     mark(staged.path())?;
-    staged.commit()?;
+    staged.commit_cached()?;
     Ok(())
 }
 

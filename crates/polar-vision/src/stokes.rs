@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use crate::error::CliError;
 use crate::input::{InputArgs, InputFile, read_input, resolve};
 use crate::out_dir;
+use crate::timings::Timings;
 
 /// Arguments of `polar-vision stokes`.
 #[derive(Debug, Args)]
@@ -32,8 +33,9 @@ s0.png shows S0 in colour (sRGB, from 0 to the 99.5th percentile of the brightes
 aolp.png, dolp.png and mask.png are of the luminance."
 )]
 pub struct StokesArgs {
-    /// A raw mosaic PNG (8- or 16-bit grayscale, IMX250MZR layout), or a sample directory
-    /// holding raw.png (or, without raw.png, stokes.exr).
+    /// A raw mosaic PNG (8- or 16-bit grayscale, IMX250MZR layout, or IMX250MYR with
+    /// --pattern rgb), a Stokes EXR (S0, S1, S2, or a colour one's S0.R ... S2.B), or a
+    /// sample directory holding raw.png (or, without raw.png, stokes.exr).
     pub input: PathBuf,
     /// Output directory: new, empty, or an earlier output of polar-vision, which is
     /// replaced as a whole once every file is written.
@@ -46,6 +48,11 @@ pub struct StokesArgs {
     /// dolp.png, s0.png), mask. Default: all.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = Output::ALL)]
     pub outputs: Vec<Output>,
+    /// Also print the wall time of each stage: reading, exposure checks, demosaicing with
+    /// the Stokes products (one fused pass), the validity mask, each output file (encoded
+    /// in parallel, so their times overlap) and moving the folder into place.
+    #[arg(long)]
+    pub timings: bool,
 }
 
 /// Runs the subcommand.
@@ -61,13 +68,14 @@ pub fn run(args: &StokesArgs) -> Result<(), CliError> {
         .for_each(|w| eprintln!("warning: {w}"));
     let mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let computed = start.elapsed();
-    let staged = out_dir::stage(&args.out)?;
+    let mut timings = reading.timings.clone();
+    let staged = timings.time("staging folder", || out_dir::stage(&args.out))?;
     let planes = Planes {
         planes: &obs.planes,
         colors: reading.colors.as_ref(),
     };
-    write_outputs(staged.path(), planes, mask, &args.outputs)?;
-    out_dir::commit(staged)?;
+    timings.extend(write_outputs(staged.path(), planes, mask, &args.outputs)?);
+    timings.time("commit", || out_dir::commit(staged))?;
     let (w, h) = obs.size();
     // A Stokes EXR is read as it is: --demosaic does not apply to it.
     let colour = if reading.colors.is_some() {
@@ -85,6 +93,9 @@ pub fn run(args: &StokesArgs) -> Result<(), CliError> {
         (start.elapsed() - computed).as_secs_f64() * 1e3,
         args.out.display()
     );
+    if args.timings {
+        eprintln!("timings: {timings}");
+    }
     Ok(())
 }
 
@@ -114,7 +125,18 @@ impl Output {
     ];
 }
 
-type Job<'a> = Box<dyn FnOnce() -> Result<(), polar_io::Error> + Send + 'a>;
+/// One output file's encoding: the file's name and the work.
+type Job<'a> = (
+    &'static str,
+    Box<dyn FnOnce() -> Result<(), polar_io::Error> + Send + 'a>,
+);
+
+fn job<'a>(
+    name: &'static str,
+    work: impl FnOnce() -> Result<(), polar_io::Error> + Send + 'a,
+) -> Job<'a> {
+    (name, Box::new(work))
+}
 
 /// What the outputs show: the Stokes planes (of the luminance for a colour mosaic) and,
 /// for a colour mosaic, each colour's planes.
@@ -126,43 +148,45 @@ pub struct Planes<'a> {
     pub colors: Option<&'a ColorStokesPlanes>,
 }
 
-/// Writes the selected output files into `out`, encoding them in parallel. EXR files use
-/// RLE compression (lossless; float noise does not deflate much, and ZIP costs several
-/// times the time of the whole computation).
+/// Writes the selected output files into `out`, encoding them in parallel; returns each
+/// file's encoding time. EXR files are
+/// uncompressed: the low mantissa bits of a camera's float Stokes planes are noise, which
+/// neither RLE nor ZIP shrinks (RLE's output is as large, ZIP costs several times the
+/// whole computation).
 pub fn write_outputs(
     out: &Path,
     what: Planes<'_>,
     mask: Option<&Gray<u8>>,
     outputs: &[Output],
-) -> Result<(), CliError> {
+) -> Result<Timings, CliError> {
     let want = |o: Output| outputs.contains(&o);
     let planes = what.planes;
-    let rle = ExrCompression::Rle;
+    let raw = ExrCompression::None;
     let mut jobs: Vec<Job<'_>> = Vec::new();
     if want(Output::Stokes) {
-        jobs.push(Box::new(move || {
+        jobs.push(job(vision::STOKES, move || {
             let path = out.join(vision::STOKES);
             match what.colors {
                 Some(c) => {
                     let s: Vec<&Gray<f32>> = (0..3)
                         .flat_map(|k| c.colors.iter().map(move |p| [&p.s0, &p.s1, &p.s2][k]))
                         .collect();
-                    polar_io::write_exr_planes(path, &s, &RGB_LINEAR_STOKES_CHANNELS, rle)
+                    polar_io::write_exr_planes(path, &s, &RGB_LINEAR_STOKES_CHANNELS, raw)
                 }
                 None => {
                     let s = [&planes.s0, &planes.s1, &planes.s2];
-                    polar_io::write_exr_planes3(path, s, LINEAR_STOKES_CHANNELS, rle)
+                    polar_io::write_exr_planes3(path, s, LINEAR_STOKES_CHANNELS, raw)
                 }
             }
         }));
     }
     type Pick = fn(&StokesPlanes) -> &Gray<f32>;
-    let derived: [(Output, &str, Pick); 2] = [
+    let derived: [(Output, &'static str, Pick); 2] = [
         (Output::Dolp, vision::DOLP, |p| &p.dolp),
         (Output::Aolp, vision::AOLP, |p| &p.aolp),
     ];
     for (_, name, pick) in derived.into_iter().filter(|d| want(d.0)) {
-        jobs.push(Box::new(move || {
+        jobs.push(job(name, move || {
             let path = out.join(name);
             match what.colors {
                 Some(c) => {
@@ -174,9 +198,9 @@ pub fn write_outputs(
                         RGB_CHANNELS[1],
                         RGB_CHANNELS[2],
                     ];
-                    polar_io::write_exr_planes(path, &p, &names, rle)
+                    polar_io::write_exr_planes(path, &p, &names, raw)
                 }
-                None => polar_io::write_exr_plane(path, pick(planes), Y_CHANNEL[0], rle),
+                None => polar_io::write_exr_plane(path, pick(planes), Y_CHANNEL[0], raw),
             }
         }));
     }
@@ -184,21 +208,27 @@ pub fn write_outputs(
         push_pictures(&mut jobs, out, what);
     }
     if let Some(mask) = mask.filter(|_| want(Output::Mask)) {
-        jobs.push(Box::new(move || {
+        jobs.push(job(vision::MASK, move || {
             polar_io::write_gray8_png(out.join(vision::MASK), mask)
         }));
     }
-    jobs.into_par_iter()
-        .map(|job| job())
-        .collect::<Result<(), _>>()?;
-    Ok(())
+    let took = jobs
+        .into_par_iter()
+        .map(|(name, work)| {
+            let start = Instant::now();
+            work().map(|()| (name, start.elapsed()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut timings = Timings::default();
+    took.into_iter().for_each(|(name, t)| timings.push(name, t));
+    Ok(timings)
 }
 
 /// The jobs of aolp.png, dolp.png (of `what.planes`) and s0.png (in colour for a colour mosaic).
 fn push_pictures<'a>(jobs: &mut Vec<Job<'a>>, out: &'a Path, what: Planes<'a>) {
     let planes = what.planes;
     let size = planes.s0.size();
-    jobs.push(Box::new(move || {
+    jobs.push(job(vision::AOLP_PICTURE, move || {
         polar_io::write_rgb8_png_rows(out.join(vision::AOLP_PICTURE), size, |y, bytes| {
             let (px, k) = pixel_rows(size.0, y, bytes);
             aolp_hsv_into(
@@ -208,13 +238,13 @@ fn push_pictures<'a>(jobs: &mut Vec<Job<'a>>, out: &'a Path, what: Planes<'a>) {
             );
         })
     }));
-    jobs.push(Box::new(move || {
+    jobs.push(job(vision::DOLP_PICTURE, move || {
         polar_io::write_rgb8_png_rows(out.join(vision::DOLP_PICTURE), size, |y, bytes| {
             let (px, k) = pixel_rows(size.0, y, bytes);
             colormap_into(&planes.dolp.as_slice()[k], 0.0, 1.0, px);
         })
     }));
-    jobs.push(Box::new(move || {
+    jobs.push(job(vision::S0_PICTURE, move || {
         let path = out.join(vision::S0_PICTURE);
         match what.colors {
             Some(c) => {

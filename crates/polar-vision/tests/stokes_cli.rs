@@ -508,6 +508,42 @@ fn rgb_pattern_writes_colour_channels_and_matches_the_library() {
     assert_eq!(s0.pixels(), picture.as_slice());
 }
 
+/// A colour stokes.exr as the input (the file itself, or a sample directory holding only
+/// it) gives back the same nine channels and the same luminance DoLP and AoLP, bit for bit:
+/// reading is exact and the products are the same formulas on the same values.
+#[test]
+fn colour_stokes_exr_is_read_back_as_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("colour.png");
+    polar_io::write_gray8_png(&input, &mosaic8(16, 12)).unwrap();
+    let first = dir.path().join("first");
+    let res = run(&["stokes", p(&input), "--out", p(&first), "--pattern", "rgb"]);
+    assert!(res.status.success(), "{}", stderr(&res));
+    let sample = dir.path().join("sample");
+    std::fs::create_dir(&sample).unwrap();
+    std::fs::copy(first.join(vision::STOKES), sample.join(files::STOKES)).unwrap();
+    for source in [first.join(vision::STOKES), sample] {
+        let again = dir.path().join("again");
+        let res = run(&["stokes", p(&source), "--out", p(&again)]);
+        assert!(res.status.success(), "{}", stderr(&res));
+        assert!(stderr(&res).contains("Stokes EXR"), "{}", stderr(&res));
+        for (file, names) in [
+            (vision::STOKES, &RGB_LINEAR_STOKES_CHANNELS[..]),
+            (vision::DOLP, &["Y", "R", "G", "B"][..]),
+            (vision::AOLP, &["Y", "R", "G", "B"][..]),
+        ] {
+            for name in names {
+                let read = |d: &Path| polar_io::read_exr_channel(d.join(file), name).unwrap();
+                let (a, b) = (read(&first), read(&again));
+                let bits = |g: &polar_image::Gray<f32>| -> Vec<u32> {
+                    g.as_slice().iter().map(|v| v.to_bits()).collect()
+                };
+                assert_eq!(bits(&a), bits(&b), "{} {file} {name}", source.display());
+            }
+        }
+    }
+}
+
 /// Without `--pattern`, `sensor.pattern` of the sample's meta.json decides; the flag
 /// overrides it; an unknown value there is an error naming the file and the key; a
 /// `sensor` that is not an object (or has no pattern) means mono.
