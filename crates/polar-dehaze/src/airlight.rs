@@ -461,9 +461,10 @@ impl SkyField {
     /// [`INFINITY_TOLERANCE`] of it are taken as infinity, and the plane of `p` is refitted
     /// to them by least squares. The airlight `A = P / p(x, y)` is at most `A_inf`, with
     /// equality at infinity, so `A_inf` is the upper-envelope plane of `A` over those
-    /// blocks inside extended regions ([`interior`]): a black object also has
-    /// `P / S0 = p`, at any distance, and a ramp of them down a hazy slope would tilt the
-    /// plane. `None` with fewer than 3 such blocks.
+    /// blocks inside extended regions ([`interior`]) and in the top cluster of `A`
+    /// ([`upper_blocks`]): a black object also has `P / S0 = p`, at any distance, and a
+    /// ramp of them down a hazy slope would tilt the plane. `None` with fewer than 3 such
+    /// blocks (then one `p` and `A_inf` over the frame).
     fn fit(blocks: &Blocks, proj: &[f32], candidates: &[usize]) -> Option<Self> {
         let eval = |c: &[f64; 3], i: usize| c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i];
         let dolp = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
