@@ -72,17 +72,19 @@ fn polarized_infinity(est: &AirlightEstimate, w: usize, h: usize) -> (Vec<f32>, 
     let Some(sky) = &est.sky else {
         return (vec![est.p * est.a_inf; n], None);
     };
-    let (p_inf, a): (Vec<f32>, Vec<f32>) = (0..n)
-        .into_par_iter()
-        .map(|k| {
-            let (x, y) = (
-                airlight::norm_coord(k % w, w),
-                airlight::norm_coord(k / w, h),
-            );
-            let a = sky.airlight_at(x, y);
-            ((sky.at(x, y) * a) as f32, a as f32)
-        })
-        .unzip();
+    let (mut p_inf, mut a) = (vec![0.0f32; n], vec![0.0f32; n]);
+    p_inf
+        .par_chunks_mut(w)
+        .zip(a.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(row, (p_row, a_row))| {
+            let y = airlight::norm_coord(row, h);
+            for (col, (p, a)) in p_row.iter_mut().zip(a_row.iter_mut()).enumerate() {
+                let x = airlight::norm_coord(col, w);
+                let a_inf = sky.airlight_at(x, y);
+                (*p, *a) = ((sky.at(x, y) * a_inf) as f32, a_inf as f32);
+            }
+        });
     (p_inf, Some(Gray::from_vec(w, h, a).expect("size matches")))
 }
 
