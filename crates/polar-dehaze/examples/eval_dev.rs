@@ -2,11 +2,13 @@
 //!
 //! `cargo run -p polar-dehaze --release --example dehaze_eval_dev [-- DIR [raw|stokes] [single-p] [-v]]`
 //! (default `/work/data/dev`, `stokes`; `single-p` sets `varying_airlight: false`). Per method and averaged over the `haze-*`
-//! samples: PSNR and SSIM of the dehazed S0 against `gt/clear.exr` (data range = max of
-//! the clear image; `polar_imgproc::psnr`/`ssim`) next to those of the hazy input S0,
+//! samples: PSNR and SSIM of the dehazed S0 against `gt/dehazed.exr` (`gt/clear.exr` where
+//! a sample has none; data range = max of the reference; `polar_imgproc::psnr`/`ssim`)
+//! next to those of the hazy input S0,
 //! mean absolute error and Pearson correlation of `t` against `gt/transmission.exr`, and
-//! the time of `dehaze`. `gt/clear.exr` is S0 without the medium, which also removes the
-//! haze's effect on the lighting: no dehazer can reach it, so the PSNR is a lower bound.
+//! the time of `dehaze`. Raw input is brought to the truth's radiance unit by the sensor's
+//! conversion in meta.json; a dataset folder other than the default takes every sample
+//! whose name holds `haze`.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -125,7 +127,7 @@ fn main() {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
             p.file_name()
-                .is_some_and(|n| n.to_string_lossy().starts_with("haze-"))
+                .is_some_and(|n| n.to_string_lossy().contains("haze"))
         })
         .collect();
     dirs.sort();
@@ -136,18 +138,32 @@ fn main() {
         let sample = polar_io::read_sample(dir).expect("sample");
         let fov = sample.meta["camera"]["fov_deg"].as_f64().unwrap_or(45.0);
         let obs = observation(dir, raw, fov);
-        let clear = sample.gt.clear.as_ref().expect(polar_io::files::GT_CLEAR);
-        // The raw path is in DN: bring the clear image to DN with the sensor's conversion.
-        let dn = if raw {
-            let sensor = &sample.meta["sensor"];
-            let ppu = sensor["photons_per_unit"].as_f64().unwrap_or(1.0);
-            let gain = sensor["gain_e_per_dn"].as_f64().unwrap_or(1.0);
-            (ppu / gain) as f32
+        // Score against gt/dehazed (what a dehazer can reach) where the sample has it.
+        let clear = sample
+            .gt
+            .dehazed
+            .as_ref()
+            .or(sample.gt.clear.as_ref())
+            .expect(polar_io::files::GT_CLEAR);
+        // Raw input is in DN: the sensor's conversion to the truth's radiance unit.
+        let sensor = &sample.meta["sensor"];
+        let dn_per_radiance = sensor["dn_per_radiance"].as_f64().unwrap_or_else(|| {
+            sensor["photons_per_unit"].as_f64().unwrap_or(1.0)
+                / sensor["gain_e_per_dn"].as_f64().unwrap_or(1.0)
+        });
+        let k = if raw {
+            (1.0 / dn_per_radiance) as f32
         } else {
             1.0
         };
-        let clear_dn: Vec<f32> = clear.as_slice().iter().map(|v| v * dn).collect();
-        let clear = &Gray::from_vec(clear.width(), clear.height(), clear_dn).expect("size");
+        let to_radiance = |g: &Gray<f32>| {
+            Gray::from_vec(
+                g.width(),
+                g.height(),
+                g.as_slice().iter().map(|v| v * k).collect(),
+            )
+            .expect("size")
+        };
         let gt_t = sample
             .gt
             .transmission
@@ -157,7 +173,7 @@ fn main() {
             Some(m) => m.as_slice().iter().map(|&l| l != 0).collect(),
             None => vec![true; clear.as_slice().len()],
         };
-        let [p0, s0, op0, os0] = image_scores(clear, &obs.planes.s0, &objects);
+        let [p0, s0, op0, os0] = image_scores(clear, &to_radiance(&obs.planes.s0), &objects);
         hazy.add(&Row {
             psnr: p0,
             ssim: s0,
@@ -178,7 +194,7 @@ fn main() {
             let start = Instant::now();
             let out = dehaze(&obs, &opts).expect("dehaze");
             let ms = start.elapsed().as_secs_f64() * 1e3;
-            let [p, s, op, os] = image_scores(clear, &out.radiance, &objects);
+            let [p, s, op, os] = image_scores(clear, &to_radiance(&out.radiance), &objects);
             let row = Row {
                 psnr: p,
                 ssim: s,

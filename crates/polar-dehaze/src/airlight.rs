@@ -17,14 +17,17 @@
 //!    direct light arrives (sky, or a black object). So `p` is the upper envelope of
 //!    `P / S0`: its [`ENVELOPE_QUANTILE`] quantile over blocks brighter than
 //!    [`DARK_LEVEL`] (dark blocks are dominated by noise).
-//! 3. **`p` over the frame** (`varying_airlight`, [`SkyField`]). The sky's degree of
-//!    polarization is not one number either (it follows the scattering angle). Blocks
-//!    with `P / S0 >= SKY_LEVEL p` and `P / p >= SKY_LEVEL A_inf` are sky candidates; an
-//!    upper-envelope plane of their `P / S0` picks those at infinity, and a plane fitted
-//!    to them (clamped to their range) gives `p(x, y)`. Needs [`MIN_SKY_BLOCKS`] of them.
-//! 4. **`A_inf`.** The airlight `A = P / p` grows with distance towards `A_inf`; we take
-//!    its [`AIRLIGHT_QUANTILE`] quantile over the blocks. Where sky is visible that is the
-//!    sky's S0 (Schechner et al. measure `A_inf` and `p` on the sky).
+//! 3. **`A_inf`.** The airlight `A = P / p` grows with distance towards `A_inf`; we take
+//!    its [`AIRLIGHT_QUANTILE`] quantile over the blocks: the most distant region's
+//!    airlight, which is the sky's S0 where sky is visible (Schechner et al. measure
+//!    `A_inf` and `p` on the sky).
+//! 4. **`p` and `A_inf` over the frame** (`varying_airlight`, [`SkyField`]). Neither is
+//!    one number: `p` follows the scattering angle, and the sky is brighter towards the
+//!    sun. Blocks with `P / S0 >= SKY_LEVEL p` and `P / p >= SKY_LEVEL A_inf` are sky
+//!    candidates; an upper-envelope plane of their `P / S0` picks those at infinity,
+//!    inside extended regions; a plane fitted to them gives `p(x, y)` and the
+//!    upper-envelope plane of their airlight gives `A_inf(x, y)` (both clamped to the
+//!    range seen). Needs [`MIN_SKY_BLOCKS`] of them; otherwise 1.-3. stand.
 //!
 //! Failure modes (reported as warnings where they can be detected):
 //! - no sky and no black object in view: `P / S0 < p` everywhere, so `p` is underestimated
@@ -36,8 +39,11 @@
 //! - haze thickening smoothly up to the horizon (a ground plane to infinity): hazy ground
 //!   just below the horizon passes as sky and tilts the plane of `p` (`p` too low far
 //!   from the horizon, so `t` too low there); `varying_airlight: false` avoids it;
-//! - `A_inf` is taken as one number: a sky much brighter on one side (towards the sun)
-//!   leaves `t > 0` on the darker side;
+//! - `A_inf` is a plane: a sky that varies more than a plane (a bright band around the
+//!   sun) is dehazed as a bright object where it rises above the plane; the plane's
+//!   extrapolation below the horizon is the sky's, not the airlight's towards the ground;
+//! - no sky region large enough for [`MIN_SKY_BLOCKS`] interior blocks: one `p` and
+//!   `A_inf` (a sky much brighter on one side then leaves `t > 0` on the darker side);
 //! - airlight polarization at the noise level: `p` is then noise; [`crate::polarization`]
 //!   falls back when `p < min_airlight_dolp`.
 
@@ -176,6 +182,8 @@ pub struct Blocks {
     pub x: Vec<f64>,
     /// Normalised y of the block's centre.
     pub y: Vec<f64>,
+    /// Grid cell `(column, row)` of each block.
+    pub cell: Vec<(usize, usize)>,
 }
 
 impl Blocks {
@@ -212,6 +220,7 @@ impl Blocks {
             s2: vec![],
             x: vec![],
             y: vec![],
+            cell: vec![],
         };
         for (g, a) in acc.iter().enumerate() {
             let (bx, by) = (g % gw, g / gw);
@@ -225,6 +234,7 @@ impl Blocks {
             out.s2.push((a[2] / a[3]) as f32);
             out.x.push((2.0 * x0 as f64 + bw as f64) / w as f64 - 1.0);
             out.y.push((2.0 * y0 as f64 + bh as f64) / h as f64 - 1.0);
+            out.cell.push((bx, by));
         }
         out
     }
@@ -399,15 +409,7 @@ pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
         .flatten()
         .filter(|f| f.dolp_range.0 > 0.0);
     let (p, a_inf) = match &sky_field {
-        Some(f) => {
-            let a: Vec<f32> = (0..n)
-                .map(|i| (f64::from(proj[i]) / f.at(blocks.x[i], blocks.y[i])) as f32)
-                .collect();
-            (
-                f.at(0.0, 0.0) as f32,
-                quantile(a.iter().copied(), AIRLIGHT_QUANTILE)?,
-            )
-        }
+        Some(f) => (f.at(0.0, 0.0) as f32, f.airlight_at(0.0, 0.0) as f32),
         None => (p, a_inf),
     };
     Some(AirlightEstimate {
@@ -443,39 +445,30 @@ pub struct SkyField {
     pub dolp: [f64; 3],
     /// Range of the sky blocks' `P / S0`.
     pub dolp_range: (f64, f64),
+    /// Plane coefficients `[a, b, c]` of `A_inf`: the upper envelope of the sky blocks'
+    /// airlight `P / p(x, y)` (at infinity all the light is airlight).
+    pub airlight: [f64; 3],
+    /// Range of the sky blocks' airlight.
+    pub airlight_range: (f64, f64),
     /// Number of blocks taken as infinity.
     pub blocks: usize,
 }
 
 impl SkyField {
-    /// Fits the plane. `P / S0 <= p` everywhere, with equality only where no direct light
+    /// Fits the planes. `P / S0 <= p` everywhere, with equality only where no direct light
     /// arrives, so the candidates (which include hazy but finite distances) first get an
-    /// upper-envelope plane of `P / S0` (expectile regression, [`ENVELOPE_EXPECTILE`]); the
-    /// blocks within [`INFINITY_TOLERANCE`] of it are taken as infinity and the plane is
-    /// refitted to them by least squares.
+    /// upper-envelope plane of `P / S0` ([`envelope_plane`]); the blocks within
+    /// [`INFINITY_TOLERANCE`] of it are taken as infinity, and the plane of `p` is refitted
+    /// to them by least squares. The airlight `A = P / p(x, y)` is at most `A_inf`, with
+    /// equality at infinity, so `A_inf` is the upper-envelope plane of `A` over those
+    /// blocks inside extended regions ([`interior`]) and in the top cluster of `A`
+    /// ([`upper_blocks`]): a black object also has `P / S0 = p`, at any distance, and a
+    /// ramp of them down a hazy slope would tilt the plane. `None` with fewer than 3 such
+    /// blocks (then one `p` and `A_inf` over the frame).
     fn fit(blocks: &Blocks, proj: &[f32], candidates: &[usize]) -> Option<Self> {
-        let plane_of = |idx: &[usize], v: &dyn Fn(usize) -> f64, wts: &[f64]| {
-            let phi: Vec<Vec<f64>> = idx
-                .iter()
-                .map(|&i| monomials(1, blocks.x[i], blocks.y[i]))
-                .collect();
-            let vals: Vec<(f64, f64)> = idx.iter().map(|&i| (v(i), 0.0)).collect();
-            weighted_fit(1, &phi, &vals, wts).map(|f| [f.cos[0], f.cos[1], f.cos[2]])
-        };
         let eval = |c: &[f64; 3], i: usize| c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i];
         let dolp = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
-        let mut wts = vec![1.0; candidates.len()];
-        let mut env = plane_of(candidates, &dolp, &wts)?;
-        for _ in 0..EXPECTILE_PASSES {
-            for (w, &i) in wts.iter_mut().zip(candidates) {
-                *w = if dolp(i) >= eval(&env, i) {
-                    ENVELOPE_EXPECTILE
-                } else {
-                    1.0 - ENVELOPE_EXPECTILE
-                };
-            }
-            env = plane_of(candidates, &dolp, &wts)?;
-        }
+        let env = envelope_plane(blocks, candidates, &dolp)?;
         let inf: Vec<usize> = candidates
             .iter()
             .copied()
@@ -484,21 +477,126 @@ impl SkyField {
         if inf.len() < MIN_SKY_BLOCKS {
             return None;
         }
-        let range = inf
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
-                (lo.min(dolp(i)), hi.max(dolp(i)))
-            });
+        let range = |idx: &[usize], v: &dyn Fn(usize) -> f64| {
+            idx.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
+                    (lo.min(v(i)), hi.max(v(i)))
+                })
+        };
+        let dolp_plane = plane_fit(blocks, &inf, &dolp, &vec![1.0; inf.len()])?;
+        let dolp_range = range(&inf, &dolp);
+        let airlight = |i: usize| {
+            f64::from(proj[i]) / plane(&dolp_plane, dolp_range, blocks.x[i], blocks.y[i])
+        };
+        // Black objects pass the `p` test at any distance, but their airlight is below A_inf.
+        let top = upper_blocks(blocks, &interior(blocks, &inf), &airlight)?;
         Some(Self {
-            dolp: plane_of(&inf, &dolp, &vec![1.0; inf.len()])?,
-            dolp_range: range,
+            dolp: dolp_plane,
+            dolp_range,
+            airlight: envelope_plane(blocks, &top, &airlight)?,
+            airlight_range: range(&top, &airlight),
             blocks: inf.len(),
         })
     }
 
     /// `p` at normalised `(x, y)`.
     pub fn at(&self, x: f64, y: f64) -> f64 {
-        let c = &self.dolp;
-        (c[0] + c[1] * x + c[2] * y).clamp(self.dolp_range.0, self.dolp_range.1)
+        plane(&self.dolp, self.dolp_range, x, y)
     }
+
+    /// `A_inf` at normalised `(x, y)`.
+    pub fn airlight_at(&self, x: f64, y: f64) -> f64 {
+        plane(&self.airlight, self.airlight_range, x, y)
+    }
+}
+
+/// Least-squares plane `c0 + c1 x + c2 y` of `v` over the blocks `idx` with weights `wts`.
+fn plane_fit(
+    blocks: &Blocks,
+    idx: &[usize],
+    v: &dyn Fn(usize) -> f64,
+    wts: &[f64],
+) -> Option<[f64; 3]> {
+    let phi: Vec<Vec<f64>> = idx
+        .iter()
+        .map(|&i| monomials(1, blocks.x[i], blocks.y[i]))
+        .collect();
+    let vals: Vec<(f64, f64)> = idx.iter().map(|&i| (v(i), 0.0)).collect();
+    weighted_fit(1, &phi, &vals, wts).map(|f| [f.cos[0], f.cos[1], f.cos[2]])
+}
+
+/// Upper-envelope plane of `v` over the blocks `idx`: expectile regression
+/// ([`ENVELOPE_EXPECTILE`], Newey and Powell 1987) by [`EXPECTILE_PASSES`] reweighted
+/// least-squares passes.
+fn envelope_plane(blocks: &Blocks, idx: &[usize], v: &dyn Fn(usize) -> f64) -> Option<[f64; 3]> {
+    let mut wts = vec![1.0; idx.len()];
+    let mut env = plane_fit(blocks, idx, v, &wts)?;
+    for _ in 0..EXPECTILE_PASSES {
+        for (w, &i) in wts.iter_mut().zip(idx) {
+            *w = if v(i) >= env[0] + env[1] * blocks.x[i] + env[2] * blocks.y[i] {
+                ENVELOPE_EXPECTILE
+            } else {
+                1.0 - ENVELOPE_EXPECTILE
+            };
+        }
+        env = plane_fit(blocks, idx, v, &wts)?;
+    }
+    Some(env)
+}
+
+/// The blocks of `idx` whose four grid neighbours are in `idx` too (or outside the frame):
+/// the inside of extended regions. A sky is one; a black object, whose `P / S0` is `p` at
+/// any distance, is usually too small to keep a block.
+fn interior(blocks: &Blocks, idx: &[usize]) -> Vec<usize> {
+    let set: std::collections::HashSet<(usize, usize)> =
+        idx.iter().map(|&i| blocks.cell[i]).collect();
+    let (gw, gh) = blocks
+        .cell
+        .iter()
+        .fold((0, 0), |(w, h), &(x, y)| (w.max(x + 1), h.max(y + 1)));
+    let inside = |(x, y): (usize, usize), dx: isize, dy: isize| match (
+        x.checked_add_signed(dx),
+        y.checked_add_signed(dy),
+    ) {
+        (Some(nx), Some(ny)) if nx < gw && ny < gh => set.contains(&(nx, ny)),
+        _ => true,
+    };
+    idx.iter()
+        .copied()
+        .filter(|&i| {
+            let c = blocks.cell[i];
+            [(-1, 0), (1, 0), (0, -1), (0, 1)]
+                .iter()
+                .all(|&(dx, dy)| inside(c, dx, dy))
+        })
+        .collect()
+}
+
+/// The blocks of `idx` not more than [`INFINITY_TOLERANCE`] below the least-squares plane
+/// of `v` over the blocks kept, iterated from all of `idx` to a fixed point (at most
+/// [`EXPECTILE_PASSES`] times): the top cluster of `v`, without the values well below it
+/// that would tilt an envelope plane. `None` with fewer than 3 blocks.
+fn upper_blocks(blocks: &Blocks, idx: &[usize], v: &dyn Fn(usize) -> f64) -> Option<Vec<usize>> {
+    let mut kept = idx.to_vec();
+    for _ in 0..EXPECTILE_PASSES {
+        let c = plane_fit(blocks, &kept, v, &vec![1.0; kept.len()])?;
+        let next: Vec<usize> = idx
+            .iter()
+            .copied()
+            .filter(|&i| {
+                v(i) >= (1.0 - INFINITY_TOLERANCE)
+                    * (c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i])
+            })
+            .collect();
+        if next == kept || next.len() < 3 {
+            break;
+        }
+        kept = next;
+    }
+    (kept.len() >= 3).then_some(kept)
+}
+
+/// `c0 + c1 x + c2 y` clamped to `range`.
+fn plane(c: &[f64; 3], range: (f64, f64), x: f64, y: f64) -> f64 {
+    (c[0] + c[1] * x + c[2] * y).clamp(range.0, range.1)
 }

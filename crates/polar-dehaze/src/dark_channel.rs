@@ -15,7 +15,7 @@ use polar_image::Gray;
 use polar_imgproc::min_filter;
 
 use crate::prep::Normalized;
-use crate::{DehazeError, DehazeOptions, Method, RawEstimate};
+use crate::{DehazeError, DehazeOptions, Inversion, Method, RawEstimate};
 
 /// Fraction of the pixels with the highest dark channel among which `A_inf` is the brightest.
 pub const AIRLIGHT_FRACTION: f64 = 0.001;
@@ -35,7 +35,9 @@ pub fn transmission(input: &Normalized, opts: &DehazeOptions) -> Result<RawEstim
         return Ok(RawEstimate {
             raw_t: Gray::from_vec(w, h, vec![1.0; w * h]).expect("size matches"),
             airlight_inf: 1.0,
+            airlight_field: None,
             airlight_dolp: 0.0,
+            inversion: Inversion::Clamped,
             method: Method::DarkChannel,
             guided_eps: opts.guided_eps,
             warnings,
@@ -50,7 +52,9 @@ pub fn transmission(input: &Normalized, opts: &DehazeOptions) -> Result<RawEstim
     Ok(RawEstimate {
         raw_t: Gray::from_vec(w, h, t).expect("size matches"),
         airlight_inf: a,
+        airlight_field: None,
         airlight_dolp: 0.0,
+        inversion: Inversion::Clamped,
         method: Method::DarkChannel,
         guided_eps: opts.guided_eps,
         warnings,

@@ -15,7 +15,9 @@
 //!   (CVPR 2009 / TPAMI 2011) on S0 alone, the baseline.
 //!
 //! Both refine `t` with a guided filter (guide S0; He, Sun, Tang, ECCV 2010), bound it
-//! to `[t_min, 1]` and invert the model, `L = (S0 - A_inf) / t + A_inf`.
+//! to `[t_min, 1]` and invert the model, `L = (S0 - A_inf) / t + A_inf` ([`Inversion`]:
+//! the dark channel as He et al., the polarization method regularised where `t` is near
+//! `t_min`, with `A_inf` varying over the frame where sky is seen).
 //!
 //! All intensities are divided by [`Observation::s0_scale`] first, so the transmission
 //! does not depend on the exposure and the radiance scales with it. Saturated and
@@ -200,13 +202,14 @@ impl DehazeOptions {
 /// The result of [`dehaze`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dehazed {
-    /// Dehazed radiance `L = (S0 - A_inf) / t + A_inf`, clamped to `>= 0`, in the unit of S0.
+    /// Dehazed radiance (the haze model inverted, [`Inversion`]), clamped to `>= 0`, in the
+    /// unit of S0.
     pub radiance: Gray<f32>,
     /// Transmission `t` in `[t_min, 1]`.
     pub transmission: Gray<f32>,
     /// Relative depth `-ln t` (optical depth, `beta z`), in `[0, -ln t_min]`.
     pub depth: Gray<f32>,
-    /// Airlight at infinity `A_inf`, in the unit of S0.
+    /// Airlight at infinity `A_inf`, in the unit of S0 (at the image centre where it varies).
     pub airlight_inf: f32,
     /// Degree of polarization `p` of the airlight, at the image centre where it varies
     /// (0 for the dark channel method; the estimate that was too weak after a fallback).
@@ -236,7 +239,7 @@ pub fn dehaze(obs: &Observation, opts: &DehazeOptions) -> Result<Dehazed, Dehaze
     warnings.extend(estimate.warnings.iter().cloned());
     let t = refine::refine(&input, &estimate.raw_t, opts, estimate.guided_eps)?;
     let s0 = refine::denoise(&input, &t, opts.denoise_radius)?;
-    Ok(finish(&input, &s0, t, &estimate, warnings))
+    Ok(finish(&input, &s0, t, &estimate, opts.t_min, warnings))
 }
 
 /// A raw (unrefined) transmission and the airlight it assumes, in normalised units.
@@ -244,10 +247,15 @@ pub fn dehaze(obs: &Observation, opts: &DehazeOptions) -> Result<Dehazed, Dehaze
 pub struct RawEstimate {
     /// Per-pixel transmission before refinement (any finite value; NaN where unknown).
     pub raw_t: Gray<f32>,
-    /// Airlight at infinity, normalised (`A_inf / s0_scale`).
+    /// Airlight at infinity, normalised (`A_inf / s0_scale`); at the image centre where
+    /// it varies.
     pub airlight_inf: f32,
+    /// `A_inf` per pixel, normalised, where it varies over the frame.
+    pub airlight_field: Option<Gray<f32>>,
     /// Degree of polarization of the airlight.
     pub airlight_dolp: f32,
+    /// How the radiance is recovered from this estimate.
+    pub inversion: Inversion,
     /// The method that produced `raw_t`.
     pub method: Method,
     /// The guided filter's regularisation for this estimate.
@@ -256,24 +264,62 @@ pub struct RawEstimate {
     pub warnings: Vec<String>,
 }
 
-/// Radiance `(S0 - A_inf) / t + A_inf` (clamped to `>= 0`) and depth `-ln t`, back in
+/// How the haze model `S0 - A_inf = t (L - A_inf)` is solved for `L`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inversion {
+    /// `L = (S0 - A_inf) / t + A_inf` with `t >= t_min` (He et al.; gain up to `1 / t_min`).
+    Clamped,
+    /// Tikhonov-regularised least squares, weight `w = t_min^2 (1 - t)` on `L - A_inf`:
+    /// `L = A_inf + t (S0 - A_inf) / (t^2 + w)`. Where `t` is near `t_min` (sky, dense
+    /// haze: the radiance is not recoverable) the result tends to the local airlight instead
+    /// of multiplying the misfit of `A_inf` by `1 / t_min` (the gain `t / (t^2 + w)` peaks
+    /// at `t = t_min` with `1 / (t_min (2 - t_min))`, about half); haze-free pixels (`t = 1`) are returned exactly, and in between
+    /// `L - A_inf` is shrunk by the fraction `w / (t^2 + w)` (2 % at `t = 0.5`, `t_min = 0.1`).
+    Regularized,
+}
+
+impl Inversion {
+    /// `L` from `S0`, `t` and `A_inf` (normalised units).
+    pub fn radiance(self, s0: f32, t: f32, a_inf: f32, t_min: f32) -> f32 {
+        match self {
+            Inversion::Clamped => (s0 - a_inf) / t + a_inf,
+            Inversion::Regularized => {
+                a_inf + t * (s0 - a_inf) / (t * t + t_min * t_min * (1.0 - t))
+            }
+        }
+    }
+}
+
+/// Radiance by the estimate's [`Inversion`] (clamped to `>= 0`) and depth `-ln t`, back in
 /// the unit of S0.
 fn finish(
     input: &prep::Normalized,
     s0: &Gray<f32>,
     t: Gray<f32>,
     est: &RawEstimate,
+    t_min: f32,
     warnings: Vec<String>,
 ) -> Dehazed {
     let (w, h) = input.s0.size();
     let a = est.airlight_inf;
     let scale = input.scale;
-    let radiance: Vec<f32> = s0
-        .as_slice()
-        .par_iter()
-        .zip(t.as_slice())
-        .map(|(&i, &t)| (((i - a) / t + a).max(0.0)) * scale)
-        .collect();
+    let inversion = est.inversion;
+    let invert = |i: f32, t: f32, a: f32| inversion.radiance(i, t, a, t_min).max(0.0) * scale;
+    let radiance: Vec<f32> = match &est.airlight_field {
+        Some(field) => s0
+            .as_slice()
+            .par_iter()
+            .zip(t.as_slice())
+            .zip(field.as_slice())
+            .map(|((&i, &t), &a)| invert(i, t, a))
+            .collect(),
+        None => s0
+            .as_slice()
+            .par_iter()
+            .zip(t.as_slice())
+            .map(|(&i, &t)| invert(i, t, a))
+            .collect(),
+    };
     let depth: Vec<f32> = t
         .as_slice()
         .par_iter()
@@ -287,5 +333,37 @@ fn finish(
         airlight_dolp: est.airlight_dolp,
         method: est.method,
         warnings,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Inversion;
+
+    #[test]
+    fn regularized_inversion_is_exact_without_haze_and_bounded_at_t_min() {
+        let (s0, a, t_min) = (0.3f32, 0.8f32, 0.1f32);
+        for inv in [Inversion::Clamped, Inversion::Regularized] {
+            // t = 1: L = S0 (one rounding).
+            assert!(
+                (inv.radiance(s0, 1.0, a, t_min) - s0).abs() < 1e-6,
+                "{inv:?}"
+            );
+        }
+        // At t = t_min the clamped gain is 1 / t_min = 10; the regularised one is
+        // t_min / (t_min^2 (2 - t_min)) = 5.26, its maximum over t.
+        let gain = |inv: Inversion| (inv.radiance(s0, t_min, a, t_min) - a) / (s0 - a);
+        assert!((gain(Inversion::Clamped) - 10.0).abs() < 1e-4);
+        let g = gain(Inversion::Regularized);
+        assert!((g - 1.0 / (t_min * (2.0 - t_min))).abs() < 1e-4, "gain {g}");
+        // t = 0.5: within 2 % of the exact inverse.
+        let (exact, reg) = (
+            Inversion::Clamped.radiance(s0, 0.5, a, t_min),
+            Inversion::Regularized.radiance(s0, 0.5, a, t_min),
+        );
+        assert!(
+            ((reg - a) / (exact - a) - 1.0).abs() < 0.02,
+            "{reg} vs {exact}"
+        );
     }
 }

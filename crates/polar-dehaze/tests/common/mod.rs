@@ -27,6 +27,9 @@ pub struct Haze {
     /// Transmission (0 on the sky).
     pub t: Vec<f32>,
     pub a_inf: f32,
+    /// Change of `A_inf` from the left to the right edge's centre line: `A_inf (1 + a_tilt x)`,
+    /// `x` in `[-1, 1]` (a sky brighter towards the sun).
+    pub a_tilt: f32,
     pub p: f32,
     /// Airlight AoLP per pixel, radians.
     pub alpha: Vec<f32>,
@@ -67,6 +70,7 @@ impl Haze {
             radiance,
             t,
             a_inf: 0.8,
+            a_tilt: 0.0,
             p,
             alpha,
             unit: 500.0,
@@ -78,12 +82,18 @@ impl Haze {
         let n = self.w * self.h;
         let (mut s0, mut s1, mut s2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         for k in 0..n {
-            let a = self.a_inf * (1.0 - self.t[k]);
+            let a = self.a_inf_at(k) * (1.0 - self.t[k]);
             s0[k] = self.unit * (self.radiance[k] * self.t[k] + a);
             s1[k] = self.unit * self.p * a * (2.0 * self.alpha[k]).cos();
             s2[k] = self.unit * self.p * a * (2.0 * self.alpha[k]).sin();
         }
         (s0, s1, s2)
+    }
+
+    /// `A_inf` at pixel `k`.
+    pub fn a_inf_at(&self, k: usize) -> f32 {
+        let x = (2 * (k % self.w) + 1) as f32 / self.w as f32 - 1.0;
+        self.a_inf * (1.0 + self.a_tilt * x)
     }
 
     pub fn observation(&self) -> Observation {
