@@ -31,13 +31,35 @@ pub fn aolp_hsv_into(aolp: &[f32], dolp: &[f32], out: &mut [[u8; 3]]) {
         .zip(dolp)
         .for_each(|((px, &a), &d)| {
             *px = if a.is_finite() && d.is_finite() {
-                let hue = (a.rem_euclid(std::f32::consts::PI) / std::f32::consts::PI * 179.0) as u8;
+                let hue = (angle_mod_pi(a) / std::f32::consts::PI * 179.0) as u8;
                 let value = (d.clamp(0.0, 1.0) * 255.0) as u8;
-                hsv_to_rgb(hue, 255, value)
+                full_saturation_table()[usize::from(hue) * 256 + usize::from(value)]
             } else {
                 [0; 3]
             };
         });
+}
+
+/// `a.rem_euclid(π)`, without the division inside the AoLP range `(-π, π)` (where it is
+/// exactly `a` or `a + π`).
+fn angle_mod_pi(a: f32) -> f32 {
+    use std::f32::consts::PI;
+    match a {
+        a if (0.0..PI).contains(&a) => a,
+        a if a > -PI && a < 0.0 => a + PI,
+        a => a.rem_euclid(PI),
+    }
+}
+
+/// [`hsv_to_rgb`] at saturation 255 for every hue `0..180` and value `0..=255`, indexed
+/// `hue * 256 + value`: one look-up per pixel instead of the float sector arithmetic.
+fn full_saturation_table() -> &'static [[u8; 3]] {
+    static TABLE: std::sync::OnceLock<Vec<[u8; 3]>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        (0..180u8)
+            .flat_map(|h| (0..=255u8).map(move |v| hsv_to_rgb(h, 255, v)))
+            .collect()
+    })
 }
 
 /// OpenCV's 8-bit `HSV2RGB`: hue in `0..180` (2° steps), saturation and value in `0..=255`.
@@ -138,6 +160,33 @@ pub fn srgb_into(rgb: [&[f32]; 3], vmax: f32, out: &mut [[u8; 3]]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fast AoLP path equals `rem_euclid` bit for bit on both sides of 0 and at ±π/2,
+    /// and the look-up table equals the arithmetic at every hue and value.
+    #[test]
+    fn aolp_fast_paths_equal_the_definitions() {
+        use std::f32::consts::{FRAC_PI_2, PI};
+        let angles = (-2000..=2000).map(|k| k as f32 * 0.0016).chain([
+            -FRAC_PI_2,
+            FRAC_PI_2,
+            -0.0,
+            0.0,
+            -PI,
+            PI,
+            7.5,
+            -7.5,
+            f32::MIN_POSITIVE,
+        ]);
+        for a in angles {
+            assert_eq!(angle_mod_pi(a).to_bits(), a.rem_euclid(PI).to_bits(), "{a}");
+        }
+        for h in 0..180u8 {
+            for v in 0..=255u8 {
+                let got = full_saturation_table()[usize::from(h) * 256 + usize::from(v)];
+                assert_eq!(got, hsv_to_rgb(h, 255, v), "hue {h} value {v}");
+            }
+        }
+    }
 
     #[test]
     fn hsv_primaries() {
