@@ -196,7 +196,7 @@ pub const MODEL_FILE: Target = Target {
     run: |data| {
         let path = Path::new("material-knn.bin");
         named(
-            polar_material::knn::KnnClassifier::from_bytes(data, path),
+            polar_material::knn::KnnClassifier::from_bytes(data, path, polar_material::knn::EXPECT),
             path,
         );
     },

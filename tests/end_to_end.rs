@@ -130,6 +130,60 @@ fn train_material_then_eval_with_the_model() {
     );
 }
 
+/// `train transparent` on the ci glass family writes a model that `run
+/// --transparent-method learned --transparent-model` uses (its mask and metrics are
+/// written; the IoU of a model trained on 4 tiny samples is not asserted); a damaged model
+/// file, and a model without the learned method, are refused naming the option.
+#[test]
+fn train_transparent_then_run_with_the_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("transparent.knn");
+    let trained = vision(&[
+        "train",
+        "transparent",
+        arg(standard_ci()),
+        "--family",
+        "glass",
+        "--max-points",
+        "500",
+        "--out",
+        arg(&model),
+    ]);
+    assert_eq!(trained, Ok(true));
+    let sample = standard_ci().join("glass-00000");
+    let run = |method: &str, model: &std::path::Path, out: &str| {
+        vision(&[
+            "run",
+            arg(&sample),
+            "--tasks",
+            "transparent",
+            "--transparent-method",
+            method,
+            "--transparent-model",
+            arg(model),
+            "--out",
+            arg(&dir.path().join(out)),
+        ])
+    };
+    assert_eq!(run("learned", &model, "run"), Ok(true));
+    let out = dir.path().join("run");
+    assert!(out.join(vision::TRANSPARENT).is_file());
+    let iou = json(&out.join(vision::METRICS))["tasks"]["transparent"]["metrics"]["iou"]
+        .as_f64()
+        .expect("an IoU against gt/transparent.png");
+    assert!((0.0..=1.0).contains(&iou), "{iou}");
+    let bad = dir.path().join("bad.knn");
+    std::fs::write(&bad, b"not a model").unwrap();
+    for (method, file, out) in [("learned", &bad, "bad"), ("cues", &model, "cues")] {
+        let err = run(method, file, out).unwrap_err();
+        let name = file.file_name().unwrap().to_str().unwrap();
+        assert!(
+            err.contains("--transparent-model") && err.contains(name),
+            "{method}: {err}"
+        );
+    }
+}
+
 #[test]
 fn shape_from_polarization_on_the_ci_shape_family() {
     let (_dir, m) = eval("sfp", "sfp", "2");

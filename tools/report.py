@@ -45,7 +45,10 @@ TASKS = {
                  False, {"physics rule, with sfp normals": ["--tasks", "sfp,material"],
                          "physics rule, no normals": ["--tasks", "material"],
                          "kNN, builtin model": ["--tasks", "material", "--material-model", "builtin"]}),
-    "transparent": (["glass"], "iou", "mask IoU", False, {"training-free": []}),
+    "transparent": (["glass"], "iou", "mask IoU", False, {
+        "training-free": [],
+        "kNN, builtin model": ["--transparent-method", "learned"],
+    }),
     "dehaze": (["haze"], "against_dehazed.dehazed.psnr_db", "PSNR vs gt/dehazed (dB)", False, {
         "polarization": ["--dehaze-method", "polarization"],
         "dark channel": ["--dehaze-method", "dark-channel"],

@@ -7,7 +7,7 @@ use std::path::Path;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::LearnError;
-use crate::model::{KnnModel, Standardization};
+use crate::model::{Expect, KnnModel, Standardization};
 
 /// A kNN classifier of `D` features, ready to query.
 pub struct Knn<const D: usize> {
@@ -61,6 +61,17 @@ impl<const D: usize> Knn<D> {
             standardization: h.standardization.clone(),
             model,
         })
+    }
+
+    /// Reads, checks and indexes a model file.
+    pub fn load(path: &Path, expect: Expect<'_>) -> Result<Self, LearnError> {
+        Self::new(KnnModel::load(path, expect)?, path)
+    }
+
+    /// Parses, checks and indexes model bytes (e.g. a model compiled into the program);
+    /// `name` names them in errors.
+    pub fn from_bytes(bytes: &[u8], name: &Path, expect: Expect<'_>) -> Result<Self, LearnError> {
+        Self::new(KnnModel::from_bytes(bytes, name, expect)?, name)
     }
 
     /// The model it was built from.

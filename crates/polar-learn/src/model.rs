@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::LearnError;
+use crate::knn::balanced_subsample;
 
 /// Version of the layout above and of [`ModelHeader`]; bump on any change.
 pub const FORMAT_VERSION: u32 = 1;
@@ -185,6 +186,45 @@ impl KnnModel {
             points,
             labels,
         })
+    }
+
+    /// Fits a model on at most `max_points` of the training points (the same number per
+    /// class, a subsample fixed by `seed`: [`balanced_subsample`]) and fills the summary's
+    /// per-class counts of labelled pixels and kept points.
+    pub fn fit_balanced(
+        expect: Expect<'_>,
+        k: usize,
+        points: &[f32],
+        labels: &[u8],
+        max_points: usize,
+        seed: u64,
+        mut summary: TrainingSummary,
+    ) -> Result<Self, LearnError> {
+        let (dims, classes) = (expect.features.len(), expect.classes.len());
+        if points.len() != labels.len() * dims {
+            return Err(LearnError::Fit(format!(
+                "{} values for {} points of {dims} features",
+                points.len(),
+                labels.len()
+            )));
+        }
+        let keep = balanced_subsample(labels, classes, max_points / classes.max(1), seed);
+        let mut kept_points = Vec::with_capacity(keep.len() * dims);
+        let mut kept = Vec::with_capacity(keep.len());
+        for &i in &keep {
+            kept_points.extend_from_slice(&points[i * dims..(i + 1) * dims]);
+            kept.push(labels[i]);
+        }
+        for (c, name) in expect.classes.iter().enumerate() {
+            let count = |l: &[u8]| l.iter().filter(|&&v| usize::from(v) == c).count() as u64;
+            summary
+                .pixels_per_class
+                .insert((*name).into(), count(labels));
+            summary
+                .points_per_class
+                .insert((*name).into(), count(&kept));
+        }
+        Self::fit(expect, k, kept_points, kept, summary)
     }
 
     /// The file's bytes.

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use polar_image::LinearStokesImage;
-use polar_material::knn::{BUILTIN_MODEL, KnnClassifier};
+use polar_material::knn::{BUILTIN_MODEL, EXPECT, KnnClassifier};
 use polar_material::{Classifier, MaterialOptions, classify};
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::{Observation, StokesPlanes};
@@ -57,8 +57,8 @@ fn main() {
     let args: Vec<PathBuf> = std::env::args_os().skip(1).map(PathBuf::from).collect();
     let sample = args.first().expect("usage: knn_bench SAMPLE_DIR [MODEL]");
     let knn = match args.get(1) {
-        Some(p) => KnnClassifier::load(p),
-        None => KnnClassifier::from_bytes(BUILTIN_MODEL, Path::new("builtin")),
+        Some(p) => KnnClassifier::load(p, EXPECT),
+        None => KnnClassifier::from_bytes(BUILTIN_MODEL, Path::new("builtin"), EXPECT),
     }
     .expect("a material model");
     let h = knn.model().header.clone();

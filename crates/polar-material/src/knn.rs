@@ -5,11 +5,9 @@
 //! computed with the silhouette cues (the same at training and inference: the zenith is
 //! the sphere prior and the phase is measured against the silhouette's outward normal).
 
-use std::path::Path;
-
 use polar_image::Gray;
 use polar_imgproc::{Border, box_filter};
-use polar_learn::{Expect, Knn, KnnModel, LearnError, TrainingSummary, balanced_subsample};
+use polar_learn::{Expect, Knn};
 use polar_sensor::Observation;
 use rayon::prelude::*;
 
@@ -59,36 +57,8 @@ pub const EXPECT: Expect<'static> = Expect {
 /// `datasets-synth/suites/material-train.toml` by `tools/train-default-models.sh`.
 pub const BUILTIN_MODEL: &[u8] = include_bytes!("../models/material-knn.bin");
 
-/// A loaded material kNN classifier.
-#[derive(Debug)]
-pub struct KnnClassifier {
-    knn: Knn<DIMS>,
-}
-
-impl KnnClassifier {
-    /// Reads and checks a model file.
-    pub fn load(path: &Path) -> Result<Self, LearnError> {
-        Self::new(KnnModel::load(path, EXPECT)?, path)
-    }
-
-    /// Parses and checks model bytes (e.g. a model compiled into the program); `name`
-    /// names them in errors.
-    pub fn from_bytes(bytes: &[u8], name: &Path) -> Result<Self, LearnError> {
-        Self::new(KnnModel::from_bytes(bytes, name, EXPECT)?, name)
-    }
-
-    /// Indexes a model.
-    pub fn new(model: KnnModel, name: &Path) -> Result<Self, LearnError> {
-        Ok(Self {
-            knn: Knn::new(model, name)?,
-        })
-    }
-
-    /// The model.
-    pub fn model(&self) -> &KnnModel {
-        self.knn.model()
-    }
-}
+/// A loaded material kNN classifier (load it with [`EXPECT`]).
+pub type KnnClassifier = Knn<DIMS>;
 
 /// Per-pixel feature vectors ([`FEATURES`]), row-major, one per pixel.
 pub fn pixel_features(p: &Prepared) -> Result<Vec<[f32; DIMS]>, MaterialError> {
@@ -216,7 +186,7 @@ pub fn metal_probability(
     let queried: Vec<usize> = (0..rep.len()).filter(|&k| rep[k] == k).collect();
     let answers: Vec<f32> = queried
         .par_iter()
-        .map(|&k| clf.knn.fraction(&x.at(k), METAL - 1))
+        .map(|&k| clf.fraction(&x.at(k), METAL - 1))
         .collect();
     let mut answer = vec![0.5f32; rep.len()];
     for (&k, &a) in queried.iter().zip(&answers) {
@@ -262,35 +232,6 @@ pub fn add_training_pixels(
         }
     }
     Ok(())
-}
-
-/// Fits a model on all training points, keeping at most `max_points` of them (half per
-/// class, a subsample fixed by `seed`); fills the summary's per-class counts.
-pub fn fit(
-    points: &[f32],
-    classes: &[u8],
-    k: usize,
-    max_points: usize,
-    seed: u64,
-    mut summary: TrainingSummary,
-) -> Result<KnnModel, LearnError> {
-    let keep = balanced_subsample(classes, CLASSES.len(), max_points / CLASSES.len(), seed);
-    let mut kept_points = Vec::with_capacity(keep.len() * DIMS);
-    let mut kept = Vec::with_capacity(keep.len());
-    for &i in &keep {
-        kept_points.extend_from_slice(&points[i * DIMS..(i + 1) * DIMS]);
-        kept.push(classes[i]);
-    }
-    for (c, name) in CLASSES.iter().enumerate() {
-        let count = |l: &[u8]| l.iter().filter(|&&v| usize::from(v) == c).count() as u64;
-        summary
-            .pixels_per_class
-            .insert((*name).into(), count(classes));
-        summary
-            .points_per_class
-            .insert((*name).into(), count(&kept));
-    }
-    KnnModel::fit(EXPECT, k, kept_points, kept, summary)
 }
 
 #[cfg(test)]

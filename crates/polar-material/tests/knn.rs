@@ -6,6 +6,7 @@ use polar_image::Gray;
 use std::path::Path;
 use std::sync::Arc;
 
+use polar_learn::KnnModel;
 use polar_material::knn::{self, KnnClassifier};
 use polar_material::{Classifier, DIELECTRIC, METAL, MaterialOptions, classify, prepare};
 use polar_optics::pixel_frame::CameraModel;
@@ -75,7 +76,16 @@ fn knn_trained_on_one_scene_labels_another() {
     )
     .unwrap();
     assert!(classes.contains(&0) && classes.contains(&1));
-    let model = knn::fit(&points, &classes, 5, 1000, 1, Default::default()).unwrap();
+    let model = KnnModel::fit_balanced(
+        knn::EXPECT,
+        5,
+        &points,
+        &classes,
+        1000,
+        1,
+        Default::default(),
+    )
+    .unwrap();
     assert!(model.labels.len() <= 1000);
     let clf = Classifier::Knn(Arc::new(
         KnnClassifier::new(model, Path::new("mem")).unwrap(),
@@ -100,7 +110,8 @@ fn knn_trained_on_one_scene_labels_another() {
 /// list and classes (a model left stale by a feature change fails here).
 #[test]
 fn builtin_model_matches_the_feature_list() {
-    let clf = KnnClassifier::from_bytes(knn::BUILTIN_MODEL, Path::new("builtin")).unwrap();
+    let clf =
+        KnnClassifier::from_bytes(knn::BUILTIN_MODEL, Path::new("builtin"), knn::EXPECT).unwrap();
     let h = &clf.model().header;
     assert_eq!(h.task, knn::TASK);
     assert_eq!(h.features, knn::FEATURES);
@@ -131,7 +142,8 @@ fn tiled(obs: &Observation, n: usize) -> Observation {
 fn results_do_not_depend_on_the_thread_count() {
     let (obs, _, _) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
     let obs = tiled(&obs, 6);
-    let knn = KnnClassifier::from_bytes(knn::BUILTIN_MODEL, Path::new("builtin")).unwrap();
+    let knn =
+        KnnClassifier::from_bytes(knn::BUILTIN_MODEL, Path::new("builtin"), knn::EXPECT).unwrap();
     let run = |threads: usize, clf: &Classifier, smooth_regions: bool| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -2,8 +2,11 @@
 //!
 //! ```text
 //! cargo run -p polar-transparency --release --example eval_dev -- [DATA_DIR] [--stokes] [-v]
+//!     [--model FILE|builtin] [--glass PREFIX] [--thresholds T,T,...]
 //! ```
-//! `DATA_DIR` defaults to `/work/data/dev`. Observations are decoded from `raw.png`
+//! `DATA_DIR` defaults to `/work/data/dev`; `--model` uses the learned segmenter with that
+//! model file; `--glass` names the glass samples (default `glass-`); `--thresholds` scores
+//! each threshold in turn (default: the segmenter's own). Observations are decoded from `raw.png`
 //! (residual demosaicing, validity flags; `--stokes` reads the noiseless `stokes.exr`).
 //! Per noise level: on `glass-*`, mean and pooled mask IoU, precision and recall against
 //! `gt/transparent.png`; on `materials-*` (opaque dielectrics and metals, no glass), the
@@ -19,7 +22,12 @@ use polar_imgproc::iou;
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::mask::validity_mask;
 use polar_sensor::{DemosaicMethod, Observation, StokesPlanes, stokes_planes};
-use polar_transparency::{TransparencyOptions, detect};
+use polar_transparency::knn::{BUILTIN_MODEL, EXPECT, KnnClassifier};
+use polar_transparency::{Segmenter, TransparencyOptions, detect};
+
+/// The binaries' allocator, so the times are what `polar-vision run` sees.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 struct Case {
     name: String,
@@ -108,11 +116,34 @@ fn main() {
     let verbose = args.iter().any(|a| a == "-v");
     let root = args
         .iter()
-        .find(|a| !a.starts_with('-'))
+        .enumerate()
+        .find(|(i, a)| {
+            !a.starts_with('-')
+                && (*i == 0 || !args[i - 1].starts_with("--") || args[i - 1] == "--stokes")
+        })
+        .map(|(_, a)| a)
         .map_or_else(|| PathBuf::from("/work/data/dev"), PathBuf::from);
     let dump = std::env::var("DUMP").ok();
-    let opts = TransparencyOptions::default();
-    let glass: Vec<Case> = dirs(&root, "glass-")
+    let value = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .map(|i| args[i + 1].clone())
+    };
+    let segmenter = match value("--model") {
+        None => Segmenter::Cues,
+        Some(m) if m == "builtin" => Segmenter::Knn(std::sync::Arc::new(
+            KnnClassifier::from_bytes(BUILTIN_MODEL, Path::new("builtin"), EXPECT).unwrap(),
+        )),
+        Some(m) => Segmenter::Knn(std::sync::Arc::new(
+            KnnClassifier::load(Path::new(&m), EXPECT).unwrap(),
+        )),
+    };
+    let thresholds: Vec<Option<f32>> = match value("--thresholds") {
+        None => vec![None],
+        Some(t) => t.split(',').map(|v| Some(v.parse().unwrap())).collect(),
+    };
+    let prefix = value("--glass").unwrap_or_else(|| "glass-".into());
+    let glass: Vec<Case> = dirs(&root, &prefix)
         .iter()
         .map(|d| load(d, from_stokes))
         .collect();
@@ -138,7 +169,11 @@ fn main() {
         .collect();
     noises.sort();
     noises.dedup();
-    for noise in &noises {
+    for (noise, threshold) in noises
+        .iter()
+        .flat_map(|n| thresholds.iter().map(move |t| (n, *t)))
+    {
+        let opts = TransparencyOptions { threshold };
         let mut g = Glass::default();
         for c in glass.iter().filter(|c| &c.noise == noise) {
             let truth = binary(
@@ -147,7 +182,7 @@ fn main() {
                     .expect(polar_io::files::GT_TRANSPARENT),
             );
             let t = Instant::now();
-            let out = detect(&c.obs, &opts).expect("detect");
+            let out = detect(&c.obs, &segmenter, &opts).expect("detect");
             g.secs += t.elapsed().as_secs_f64();
             let pred = binary(&out.mask);
             let one = iou(&pred, &truth).unwrap().unwrap_or(1.0);
@@ -172,7 +207,7 @@ fn main() {
         let mut o = Opaque::default();
         for c in opaque.iter().filter(|c| &c.noise == noise) {
             let mat = c.material.as_ref().expect(polar_io::files::GT_MATERIAL);
-            let out = detect(&c.obs, &opts).expect("detect");
+            let out = detect(&c.obs, &segmenter, &opts).expect("detect");
             o.n += 1;
             for (&p, &l) in out.mask.as_slice().iter().zip(mat.as_slice()) {
                 let obj = l == 1 || l == 2;
@@ -186,7 +221,7 @@ fn main() {
             }
         }
         let pct = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
-        println!("noise = {noise}");
+        println!("noise = {noise}, threshold {threshold:?}");
         println!(
             "  glass     n={:2} mean IoU {:.3}  pooled IoU {:.3}  precision {:5.1}%  recall {:5.1}%  {:.1} ms/img",
             g.n,
@@ -203,11 +238,11 @@ fn main() {
             pct(o.fp, o.pixels)
         );
     }
-    time_megapixel(&opts);
+    time_megapixel(&segmenter);
 }
 
 /// Time of one 1024x1024 detection on a synthetic scene (a polarized disc per 256² tile).
-fn time_megapixel(opts: &TransparencyOptions) {
+fn time_megapixel(segmenter: &Segmenter) {
     let n = 1024;
     let mut planes = StokesPlanes::new(n, n);
     for y in 0..n {
@@ -225,7 +260,7 @@ fn time_megapixel(opts: &TransparencyOptions) {
     let planes = StokesPlanes::from_linear_stokes(&planes.linear_stokes());
     let obs = Observation::new(planes, CameraModel::Orthographic);
     let t = Instant::now();
-    let out = detect(&obs, opts).unwrap();
+    let out = detect(&obs, segmenter, &TransparencyOptions::default()).unwrap();
     println!(
         "1 MP (1024x1024, synthetic discs): {:.0} ms, {} pixels on",
         t.elapsed().as_secs_f64() * 1e3,

@@ -14,8 +14,18 @@
 //!
 //! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass.
 //! The cue that separates them is transmission: see [`cues`] for what is measured.
+//!
+//! [`detect`] runs one of two segmenters ([`Segmenter`]): the cue score above, which needs
+//! no training, or a k-nearest-neighbour classifier over per-pixel features built on the
+//! same cues ([`knn`], trained by `polar-vision train transparent`); both end in the same
+//! mask clean-up.
 
 pub mod cues;
+pub mod knn;
+
+use std::fmt;
+use std::str::FromStr;
+use std::sync::Arc;
 
 use polar_image::Gray;
 use polar_imgproc::threshold_otsu;
@@ -34,22 +44,80 @@ pub enum TransparencyError {
     /// The threshold is not a finite number in `[0, 1]`.
     #[error("threshold {0} is not in [0, 1]")]
     Threshold(f32),
+    /// An input does not have the observation's size.
+    #[error("{what} is {got:?}, the observation {expected:?}")]
+    SizeMismatch {
+        /// Which input.
+        what: &'static str,
+        /// The observation's `(width, height)`.
+        expected: (usize, usize),
+        /// The input's `(width, height)`.
+        got: (usize, usize),
+    },
+    /// A segmenter name is not known.
+    #[error("unknown transparent method {0:?} (known: cues, learned)")]
+    UnknownMethod(String),
     /// An image-processing primitive failed.
     #[error(transparent)]
     Imgproc(#[from] polar_imgproc::Error),
 }
 
+/// The segmenters by name, as the command line selects them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Method {
+    /// The cue score with Otsu's threshold ([`cues`]); needs no training.
+    #[default]
+    Cues,
+    /// The kNN classifier of [`knn`] (needs a model).
+    Learned,
+}
+
+impl FromStr for Method {
+    type Err = TransparencyError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "cues" => Ok(Method::Cues),
+            "learned" => Ok(Method::Learned),
+            _ => Err(TransparencyError::UnknownMethod(s.into())),
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Method::Cues => "cues",
+            Method::Learned => "learned",
+        })
+    }
+}
+
+/// Which segmenter scores the pixels.
+#[derive(Clone, Debug)]
+pub enum Segmenter {
+    /// The training-free cue score of [`cues::score`].
+    Cues,
+    /// The probability of transparent from a trained kNN model ([`knn::probability`]).
+    Knn(Arc<knn::KnnClassifier>),
+}
+
 /// Options of [`detect`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TransparencyOptions {
-    /// Score threshold in `[0, 1]`; `None` = Otsu's threshold of the score map, floored at
-    /// [`MIN_THRESHOLD`] so that a scene without glass is not split in two anyway.
+    /// Score threshold in `[0, 1]`; `None` = for the cues, Otsu's threshold of the score map,
+    /// floored at [`MIN_THRESHOLD`] so that a scene without glass is not split in two
+    /// anyway; for the kNN, [`KNN_THRESHOLD`].
     pub threshold: Option<f32>,
 }
 
 /// The Otsu threshold never goes below this score: a DoLP of a few percent coherent
 /// over a window is what depolarizing surfaces reach at most (see [`cues::score`]).
 pub const MIN_THRESHOLD: f32 = 0.3;
+
+/// The kNN's default threshold on its vote for transparent. Above the majority vote: the
+/// training points are balanced per class, so the vote over-weights transparent pixels
+/// against their share of real frames (about one in eight in the training suite).
+pub const KNN_THRESHOLD: f32 = 0.7;
 
 /// The result of [`detect`].
 #[derive(Clone, Debug, PartialEq)]
@@ -60,9 +128,10 @@ pub struct TransparencyMap {
     pub score: Gray<f32>,
 }
 
-/// Detects transparent objects in `obs`.
+/// Detects transparent objects in `obs` with `segmenter`.
 pub fn detect(
     obs: &Observation,
+    segmenter: &Segmenter,
     opts: &TransparencyOptions,
 ) -> Result<TransparencyMap, TransparencyError> {
     let (w, h) = obs.size();
@@ -74,10 +143,19 @@ pub fn detect(
     {
         return Err(TransparencyError::Threshold(t));
     }
-    let score = cues::score(obs)?;
-    let t = match opts.threshold {
-        Some(t) => t,
-        None => threshold_otsu(&score)?.max(MIN_THRESHOLD),
+    let (score, t) = match segmenter {
+        Segmenter::Cues => {
+            let score = cues::score(obs)?;
+            let t = match opts.threshold {
+                Some(t) => t,
+                None => threshold_otsu(&score)?.max(MIN_THRESHOLD),
+            };
+            (score, t)
+        }
+        Segmenter::Knn(clf) => (
+            knn::probability(clf, obs)?,
+            opts.threshold.unwrap_or(KNN_THRESHOLD),
+        ),
     };
     let seed: Vec<bool> = score.as_slice().iter().map(|&s| s > t).collect();
     let m = polar_imgproc::mask::clean(&seed, w, h)?;

@@ -1,11 +1,17 @@
 //! Analytic scenes: a glass disc over a textured, unpolarized checkerboard, with the
 //! DoLP of Fresnel transmission through two interfaces and the AoLP along the azimuth
-//! (rotated 90° from the reflection a shiny opaque object would send), and hard cases.
+//! (rotated 90° from the reflection a shiny opaque object would send), and hard cases;
+//! both segmenters (the learned one also: its model file and its training).
+
+use std::path::Path;
+use std::sync::Arc;
 
 use polar_image::Gray;
+use polar_learn::{Expect, KnnModel, LearnError};
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::{Observation, StokesPlanes};
-use polar_transparency::{ON, TransparencyOptions, detect};
+use polar_transparency::knn::{self, BUILTIN_MODEL, EXPECT, KnnClassifier};
+use polar_transparency::{ON, Segmenter, TransparencyOptions, detect};
 
 const N: usize = 96;
 
@@ -22,8 +28,13 @@ fn transmitted_dolp(t: f64, n: f64) -> f64 {
 
 /// Glass disc of radius 30 px at the centre: `Some((zenith, azimuth))` inside.
 fn disc(x: usize, y: usize) -> Option<(f64, f64)> {
-    let (dx, dy) = (x as f64 + 0.5 - 48.0, -(y as f64 + 0.5 - 48.0));
-    let r = dx.hypot(dy) / 30.0;
+    disc_at(48.0, 48.0, 30.0, x, y)
+}
+
+/// Glass disc of `radius` px centred at `(cx, cy)`: `Some((zenith, azimuth))` inside.
+fn disc_at(cx: f64, cy: f64, radius: f64, x: usize, y: usize) -> Option<(f64, f64)> {
+    let (dx, dy) = (x as f64 + 0.5 - cx, -(y as f64 + 0.5 - cy));
+    let r = dx.hypot(dy) / radius;
     (r < 1.0).then(|| ((0.98 * r).asin(), dy.atan2(dx)))
 }
 
@@ -76,7 +87,12 @@ fn iou_with_disc(mask: &Gray<u8>) -> f64 {
 /// rim of about two pixels (the window and the morphology) on a 30-pixel radius.
 #[test]
 fn glass_disc_over_checkerboard_is_found() {
-    let out = detect(&glass_scene(), &TransparencyOptions::default()).unwrap();
+    let out = detect(
+        &glass_scene(),
+        &Segmenter::Cues,
+        &TransparencyOptions::default(),
+    )
+    .unwrap();
     let iou = iou_with_disc(&out.mask);
     assert!(iou > 0.85, "IoU {iou}");
     assert!(out.score.as_slice().iter().all(|s| (0.0..=1.0).contains(s)));
@@ -87,22 +103,27 @@ fn glass_disc_over_checkerboard_is_found() {
 #[test]
 fn unpolarized_checkerboard_has_no_glass() {
     let obs = observation(|x, y| (checker(x, y), 0.0, 0.0));
-    let out = detect(&obs, &TransparencyOptions::default()).unwrap();
+    let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
     assert!(out.mask.as_slice().iter().all(|&v| v == 0));
+}
+
+/// `obs` with S0, S1, S2 multiplied by `k` (another exposure).
+fn scaled(obs: &Observation, k: f32) -> Observation {
+    let mut s = obs.planes.linear_stokes();
+    s.as_mut_slice().iter_mut().for_each(|v| *v *= k);
+    Observation::new(
+        StokesPlanes::from_linear_stokes(&s),
+        CameraModel::Orthographic,
+    )
 }
 
 #[test]
 fn scale_invariance_times_37() {
     let obs = glass_scene();
-    let mut s = obs.planes.linear_stokes();
-    s.as_mut_slice().iter_mut().for_each(|v| *v *= 37.0);
-    let obs37 = Observation::new(
-        StokesPlanes::from_linear_stokes(&s),
-        CameraModel::Orthographic,
-    );
+    let obs37 = scaled(&obs, 37.0);
     let (a, b) = (
-        detect(&obs, &TransparencyOptions::default()).unwrap(),
-        detect(&obs37, &TransparencyOptions::default()).unwrap(),
+        detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap(),
+        detect(&obs37, &Segmenter::Cues, &TransparencyOptions::default()).unwrap(),
     );
     assert_eq!(a.mask, b.mask);
     for (x, y) in a.score.as_slice().iter().zip(b.score.as_slice()) {
@@ -116,6 +137,7 @@ fn explicit_threshold_is_used_and_checked() {
     // Threshold 0: every pixel with any coherent polarization, i.e. the whole disc.
     let low = detect(
         &obs,
+        &Segmenter::Cues,
         &TransparencyOptions {
             threshold: Some(0.0),
         },
@@ -123,6 +145,7 @@ fn explicit_threshold_is_used_and_checked() {
     .unwrap();
     let none = detect(
         &obs,
+        &Segmenter::Cues,
         &TransparencyOptions {
             threshold: Some(1.0),
         },
@@ -134,6 +157,7 @@ fn explicit_threshold_is_used_and_checked() {
         assert!(
             detect(
                 &obs,
+                &Segmenter::Cues,
                 &TransparencyOptions {
                     threshold: Some(bad)
                 }
@@ -153,7 +177,8 @@ fn uniform(w: usize, h: usize, s0: f32) -> Observation {
 }
 
 fn empty_and_finite(obs: &Observation) -> bool {
-    let out = detect(obs, &TransparencyOptions::default()).expect("a finite result");
+    let out =
+        detect(obs, &Segmenter::Cues, &TransparencyOptions::default()).expect("a finite result");
     out.score.as_slice().iter().all(|s| s.is_finite())
         && out.mask.as_slice().iter().all(|&v| v == 0)
 }
@@ -168,7 +193,14 @@ fn tiny_images() {
     for (w, h) in [(1, 1), (2, 2), (3, 1)] {
         assert!(empty_and_finite(&uniform(w, h, 1.0)), "{w}x{h}");
     }
-    assert!(detect(&uniform(0, 0, 1.0), &TransparencyOptions::default()).is_err());
+    assert!(
+        detect(
+            &uniform(0, 0, 1.0),
+            &Segmenter::Cues,
+            &TransparencyOptions::default()
+        )
+        .is_err()
+    );
 }
 
 #[test]
@@ -180,7 +212,147 @@ fn nan_s0_and_saturation_do_not_panic() {
     let mut flags = Gray::<u8>::new(N, N);
     flags.as_mut_slice()[10] = polar_sensor::mask::SATURATED;
     let bad = Observation::new(planes, CameraModel::Orthographic).with_flags(flags);
-    let out = detect(&bad, &TransparencyOptions::default()).unwrap();
+    let out = detect(&bad, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
     assert!(out.score.as_slice().iter().all(|s| s.is_finite()));
     assert!(iou_with_disc(&out.mask) > 0.85);
+}
+
+// The learned segmenter.
+
+/// A glass disc of `radius` px centred at `(cx, cy)` over a checkerboard whose pixels
+/// carry a small polarization of random angle (a depolarizing surface seen by a noisy
+/// sensor: DoLP up to 0.03 per pixel, incoherent from one pixel to the next).
+fn noisy_glass_scene(cx: f64, cy: f64, radius: f64) -> (Observation, Gray<u8>) {
+    let inside = |x: usize, y: usize| disc_at(cx, cy, radius, x, y);
+    let hash = |k: usize| {
+        (
+            (k as f64 * 0.754_877_666).fract(),
+            (k as f64 * 0.569_840_29).fract(),
+        )
+    };
+    let obs = observation(|x, y| match inside(x, y) {
+        Some((ze, az)) => (0.9 * checker(x, y), transmitted_dolp(ze, 1.5), az),
+        None => {
+            let (a, b) = hash(y * N + x);
+            (checker(x, y), 0.03 * a, std::f64::consts::PI * b)
+        }
+    });
+    let truth = (0..N * N)
+        .map(|k| {
+            if inside(k % N, k / N).is_some() {
+                ON
+            } else {
+                0
+            }
+        })
+        .collect();
+    (obs, Gray::from_vec(N, N, truth).unwrap())
+}
+
+fn iou(mask: &Gray<u8>, truth: &Gray<u8>) -> f64 {
+    let pairs = mask.as_slice().iter().zip(truth.as_slice());
+    let inter = pairs
+        .clone()
+        .filter(|(p, t)| **p == ON && **t == ON)
+        .count();
+    let union = pairs.filter(|(p, t)| **p == ON || **t == ON).count();
+    inter as f64 / union.max(1) as f64
+}
+
+/// A kNN model trained on one noisy scene (disc at the centre, radius 30).
+fn trained_on_one_scene() -> KnnClassifier {
+    let (obs, truth) = noisy_glass_scene(48.0, 48.0, 30.0);
+    let (mut points, mut classes) = (Vec::new(), Vec::new());
+    knn::add_training_pixels(&obs, &truth, &mut points, &mut classes).unwrap();
+    let model =
+        KnnModel::fit_balanced(EXPECT, 7, &points, &classes, 2000, 1, Default::default()).unwrap();
+    KnnClassifier::new(model, Path::new("mem")).unwrap()
+}
+
+/// Trained on a disc at the centre, the kNN finds a disc elsewhere and of another size
+/// (IoU 0.8: the context windows and the clean-up may move the edge by about three pixels
+/// on a 24-pixel radius), and calls nothing transparent in a scene of depolarized texture
+/// alone.
+#[test]
+fn learned_separates_coherent_glass_from_a_depolarized_background() {
+    let knn = Segmenter::Knn(Arc::new(trained_on_one_scene()));
+    let opts = TransparencyOptions::default();
+    let (test, truth) = noisy_glass_scene(40.0, 56.0, 24.0);
+    let found = iou(&detect(&test, &knn, &opts).unwrap().mask, &truth);
+    assert!(found > 0.8, "IoU {found}");
+    let (background, _) = noisy_glass_scene(-100.0, -100.0, 1.0);
+    let out = detect(&background, &knn, &opts).unwrap();
+    let on = out.mask.as_slice().iter().filter(|&&v| v == ON).count();
+    assert_eq!(on, 0, "{on} pixels called transparent");
+}
+
+/// Scaling S0, S1, S2 by 37 changes no feature beyond float rounding (every feature is a
+/// ratio) and gives the builtin model's identical mask.
+#[test]
+fn learned_scale_invariance_times_37() {
+    let (obs, _) = noisy_glass_scene(48.0, 48.0, 30.0);
+    let obs37 = scaled(&obs, 37.0);
+    let (a, b) = (
+        knn::pixel_features(&obs).unwrap(),
+        knn::pixel_features(&obs37).unwrap(),
+    );
+    for (x, y) in a.iter().flatten().zip(b.iter().flatten()) {
+        assert!((x - y).abs() <= 1e-5 + 1e-4 * x.abs(), "{x} {y}");
+    }
+    let builtin = KnnClassifier::from_bytes(BUILTIN_MODEL, Path::new("builtin"), EXPECT).unwrap();
+    let seg = Segmenter::Knn(Arc::new(builtin));
+    let opts = TransparencyOptions::default();
+    let (m, m37) = (
+        detect(&obs, &seg, &opts).unwrap(),
+        detect(&obs37, &seg, &opts).unwrap(),
+    );
+    assert_eq!(m.mask, m37.mask);
+}
+
+/// The shipped model loads and names this program's task, features and classes (a model
+/// left stale by a feature change fails here).
+#[test]
+fn builtin_model_matches_the_feature_list() {
+    let clf = KnnClassifier::from_bytes(BUILTIN_MODEL, Path::new("builtin"), EXPECT).unwrap();
+    let h = &clf.model().header;
+    assert_eq!(
+        (h.task.as_str(), &h.features, &h.classes),
+        (
+            knn::TASK,
+            &knn::FEATURES.map(String::from).to_vec(),
+            &knn::CLASSES.map(String::from).to_vec()
+        )
+    );
+    assert!(h.points >= 1000 && h.summary.samples > 0, "{h:?}");
+    assert!(
+        BUILTIN_MODEL.len() < 300_000,
+        "{} bytes",
+        BUILTIN_MODEL.len()
+    );
+}
+
+/// A transparent model file reads back equal; a truncated one and one of another task are
+/// refused with errors naming the file.
+#[test]
+fn model_file_round_trip_and_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = trained_on_one_scene().model().clone();
+    let path = dir.path().join("t.knn");
+    std::fs::write(&path, model.to_bytes()).unwrap();
+    let back = KnnClassifier::load(&path, EXPECT).unwrap();
+    assert_eq!(back.model(), &model);
+    let bytes = model.to_bytes();
+    std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
+    let err = KnnClassifier::load(&path, EXPECT).unwrap_err();
+    assert!(matches!(err, LearnError::Corrupt { .. }), "{err}");
+    assert!(err.to_string().contains("t.knn"), "{err}");
+    let other = Expect {
+        task: "material",
+        ..EXPECT
+    };
+    let mut m = model.clone();
+    m.header.task = other.task.into();
+    std::fs::write(&path, m.to_bytes()).unwrap();
+    let err = KnnClassifier::load(&path, EXPECT).unwrap_err();
+    assert!(matches!(err, LearnError::WrongTask { .. }), "{err}");
 }

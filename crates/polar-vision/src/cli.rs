@@ -35,8 +35,8 @@ enum Command {
     Eval(eval::EvalArgs),
     /// Joins the outputs of `eval --shard K/N` runs into one report.
     EvalMerge(eval::MergeArgs),
-    /// Trains a task's learned model on a labelled dataset (`train material DATASET --out
-    /// MODEL`), for `run --material-model MODEL`.
+    /// Trains a task's learned model on a labelled dataset (`train material|transparent
+    /// DATASET --out MODEL`), for `run --material-model MODEL` or `--transparent-model MODEL`.
     Train(train::TrainArgs),
 }
 

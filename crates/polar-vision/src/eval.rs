@@ -84,11 +84,11 @@ impl EvalRunArgs {
     }
 
     /// What must be equal for a stored record to be reused: the options and the contents
-    /// of the material model they name (a model retrained in place is a different model).
+    /// of the models they name (a model retrained in place is a different model).
     fn fingerprint(&self) -> Result<String, CliError> {
-        let model = self.task.material_model_digest()?;
+        let models = self.task.model_digests()?;
         Ok(format!(
-            "{:?}|{:?}|{:?}|{:?}|{model:?}",
+            "{:?}|{:?}|{:?}|{:?}|{models:?}",
             self.tasks, self.input, self.read, self.task
         ))
     }
@@ -116,9 +116,7 @@ pub struct EvalReport {
 
 /// Runs the subcommand; `Ok(false)` when a sample or a task failed.
 pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
-    if args.run.tasks.contains(&crate::tasks::Task::Material) {
-        args.run.task.material_classifier()?;
-    }
+    args.run.task.check_models(&args.run.tasks)?;
     let samples = select_samples(&args.dataset, &args.family)?;
     let shard = args.shard.unwrap_or(Shard::ALL);
     let mine: Vec<&PathBuf> = samples

@@ -81,9 +81,7 @@ impl SampleReport {
 
 /// Runs the subcommand; `Ok(false)` when a task could not run.
 pub fn run(args: &RunArgs) -> Result<bool, CliError> {
-    if args.tasks.contains(&Task::Material) {
-        args.task.material_classifier()?;
-    }
+    args.task.check_models(&args.tasks)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.map_or(0, usize::from))
         .build()

@@ -1,11 +1,12 @@
 //! The options of the tasks (shared by `run` and `eval`) and the dispatch to each task.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use clap::Args;
+use polar_learn::{Expect, Knn};
 use polar_material::Classifier;
-use polar_material::knn::KnnClassifier;
+use polar_transparency::{Method as TransparentMethod, Segmenter};
 
 use crate::error::CliError;
 use polar_dehaze::Method as DehazeMethod;
@@ -50,41 +51,120 @@ pub struct TaskArgs {
     /// which needs no training.
     #[arg(long, value_name = "FILE")]
     pub material_model: Option<PathBuf>,
+    /// Transparent-object segmenter:
+    ///   cues     the cue score (coherent DoLP) with Otsu's threshold; needs no training
+    ///   learned  k nearest neighbours over per-pixel cue features (--transparent-model)
+    #[arg(verbatim_doc_comment)]
+    #[arg(long, value_name = "NAME", default_value = "cues", value_parser = parse_name::<TransparentMethod>)]
+    pub transparent_method: TransparentMethod,
+    /// The model file of `--transparent-method learned` (made by `polar-vision train
+    /// transparent`), or `builtin` (the default) for the model shipped with the program
+    /// (trained on datasets-synth/suites/transparent-train.toml).
+    #[arg(long, value_name = "FILE")]
+    pub transparent_model: Option<PathBuf>,
 }
 
-/// The `--material-model` value naming the model compiled into the program.
+/// The `--material-model` / `--transparent-model` value naming the model compiled into the
+/// program.
 pub const BUILTIN_MODEL: &str = "builtin";
 
 impl TaskArgs {
     /// The material classifier the options select; a model file that cannot be used is an
     /// error naming it (checked before any sample is read).
     pub fn material_classifier(&self) -> Result<Classifier, CliError> {
-        let Some(path) = &self.material_model else {
-            return Ok(Classifier::Physics);
-        };
-        let clf = if path.as_os_str() == BUILTIN_MODEL {
-            KnnClassifier::from_bytes(polar_material::knn::BUILTIN_MODEL, path)
-        } else {
-            KnnClassifier::load(path)
-        };
-        Ok(Classifier::Knn(Arc::new(clf.map_err(|e| {
-            CliError::Model(format!("--material-model: {e}"))
-        })?)))
+        Ok(match &self.material_model {
+            None => Classifier::Physics,
+            Some(path) => Classifier::Knn(Arc::new(load_knn(
+                "--material-model",
+                path,
+                polar_material::knn::BUILTIN_MODEL,
+                polar_material::knn::EXPECT,
+            )?)),
+        })
     }
 
-    /// Hex SHA-256 of the `--material-model` contents (of the compiled-in model for
-    /// `builtin`), `None` without one: what ties a stored result to the model it was made with.
-    pub fn material_model_digest(&self) -> Result<Option<String>, CliError> {
-        let Some(path) = &self.material_model else {
-            return Ok(None);
-        };
-        let digest = if path.as_os_str() == BUILTIN_MODEL {
-            polar_io::sha256_hex(polar_material::knn::BUILTIN_MODEL)
-        } else {
-            polar_io::sha256_file(path)
-                .map_err(|e| CliError::Model(format!("--material-model: {e}")))?
-        };
-        Ok(Some(digest))
+    /// The transparent segmenter the options select (as [`Self::material_classifier`]).
+    pub fn transparent_segmenter(&self) -> Result<Segmenter, CliError> {
+        Ok(match self.transparent_model_path()? {
+            None => Segmenter::Cues,
+            Some(path) => Segmenter::Knn(Arc::new(load_knn(
+                "--transparent-model",
+                path,
+                polar_transparency::knn::BUILTIN_MODEL,
+                polar_transparency::knn::EXPECT,
+            )?)),
+        })
+    }
+
+    /// The transparent model the options name: `--transparent-model`, by default
+    /// `builtin`, with `--transparent-method learned`; none with `cues`, where naming a
+    /// model is an error (it would be ignored).
+    fn transparent_model_path(&self) -> Result<Option<&Path>, CliError> {
+        match (self.transparent_method, &self.transparent_model) {
+            (TransparentMethod::Cues, None) => Ok(None),
+            (TransparentMethod::Cues, Some(p)) => Err(CliError::Model(format!(
+                "--transparent-model {}: only used with --transparent-method learned",
+                p.display()
+            ))),
+            (TransparentMethod::Learned, p) => {
+                Ok(Some(p.as_deref().unwrap_or(Path::new(BUILTIN_MODEL))))
+            }
+        }
+    }
+
+    /// Loads the models `tasks` use, so that an unusable model file is an error before any
+    /// sample is read.
+    pub fn check_models(&self, tasks: &[Task]) -> Result<(), CliError> {
+        if tasks.contains(&Task::Material) {
+            self.material_classifier()?;
+        }
+        if tasks.contains(&Task::Transparent) {
+            self.transparent_segmenter()?;
+        }
+        Ok(())
+    }
+
+    /// Hex SHA-256 of the contents of each model the options use (of the compiled-in model
+    /// for `builtin`), in task order, `None` where a task uses none: what ties a stored
+    /// result to the models it was made with.
+    pub fn model_digests(&self) -> Result<[Option<String>; 2], CliError> {
+        let material = self
+            .material_model
+            .as_deref()
+            .map(|p| model_digest("--material-model", p, polar_material::knn::BUILTIN_MODEL));
+        let transparent = self.transparent_model_path()?.map(|p| {
+            model_digest(
+                "--transparent-model",
+                p,
+                polar_transparency::knn::BUILTIN_MODEL,
+            )
+        });
+        Ok([material.transpose()?, transparent.transpose()?])
+    }
+}
+
+/// The kNN model `path` of option `option` (`builtin`: the compiled-in `builtin` bytes),
+/// checked against `expect`; an error names the option and the file.
+fn load_knn<const D: usize>(
+    option: &str,
+    path: &Path,
+    builtin: &[u8],
+    expect: Expect<'_>,
+) -> Result<Knn<D>, CliError> {
+    let knn = if path.as_os_str() == BUILTIN_MODEL {
+        Knn::from_bytes(builtin, path, expect)
+    } else {
+        Knn::load(path, expect)
+    };
+    knn.map_err(|e| CliError::Model(format!("{option}: {e}")))
+}
+
+/// Hex SHA-256 of model `path` of option `option` (of `builtin` for `builtin`).
+fn model_digest(option: &str, path: &Path, builtin: &[u8]) -> Result<String, CliError> {
+    if path.as_os_str() == BUILTIN_MODEL {
+        Ok(polar_io::sha256_hex(builtin))
+    } else {
+        polar_io::sha256_file(path).map_err(|e| CliError::Model(format!("{option}: {e}")))
     }
 }
 

@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
+use polar_io::GroundTruth;
 use polar_io::Validation;
-use polar_learn::TrainingSummary;
-use polar_material::knn;
+use polar_learn::{Expect, KnnModel, TrainingSummary};
+use polar_sensor::Observation;
 use rayon::prelude::*;
 
 use crate::error::CliError;
@@ -21,6 +22,48 @@ pub enum TrainTask {
     /// Material classification (metal against dielectric) by k nearest neighbours, from the
     /// labels of gt/material.png (1 dielectric, 2 metal).
     Material,
+    /// Transparent-object segmentation (transparent against everything else) by k nearest
+    /// neighbours, from gt/transparent.png (non-zero = transparent), over every valid pixel.
+    Transparent,
+}
+
+impl TrainTask {
+    /// The task's name, as in metrics.json.
+    fn name(self) -> &'static str {
+        match self {
+            TrainTask::Material => "material",
+            TrainTask::Transparent => "transparent",
+        }
+    }
+
+    /// What the task's model file declares.
+    fn expect(self) -> Expect<'static> {
+        match self {
+            TrainTask::Material => polar_material::knn::EXPECT,
+            TrainTask::Transparent => polar_transparency::knn::EXPECT,
+        }
+    }
+
+    /// Appends the training points of one sample (none where it lacks the labels).
+    fn add_pixels(
+        self,
+        obs: &Observation,
+        gt: &GroundTruth,
+        points: &mut Vec<f32>,
+        classes: &mut Vec<u8>,
+    ) -> Result<(), String> {
+        match (self, &gt.material, &gt.transparent) {
+            (TrainTask::Material, Some(labels), _) => {
+                polar_material::knn::add_training_pixels(obs, labels, points, classes)
+                    .map_err(|e| e.to_string())
+            }
+            (TrainTask::Transparent, _, Some(labels)) => {
+                polar_transparency::knn::add_training_pixels(obs, labels, points, classes)
+                    .map_err(|e| e.to_string())
+            }
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Arguments of `polar-vision train`.
@@ -31,7 +74,8 @@ path as `run` (raw.png by default), computes the task's per-pixel features on th
 classifier takes for objects, labels them from the sample's ground truth, keeps a class-balanced \
 subsample of at most --max-points (fixed by --seed: the same command gives the same file), and \
 writes the model file: format version, task, feature list, standardization, k, the training set's \
-summary and the points. Use it with `run --material-model FILE` (or `eval`)."
+summary and the points. Use it with `run --material-model FILE` or `run --transparent-method \
+learned --transparent-model FILE` (or `eval`)."
 )]
 pub struct TrainArgs {
     /// The task to train for.
@@ -66,14 +110,13 @@ pub struct TrainArgs {
 
 /// Runs the subcommand.
 pub fn train(args: &TrainArgs) -> Result<bool, CliError> {
-    let TrainTask::Material = args.task;
     let start = Instant::now();
     let samples = select_samples(&args.dataset, &args.family)?;
     let bar = progress(samples.len());
     let per_sample: Vec<(Vec<f32>, Vec<u8>)> = samples
         .par_iter()
         .map(|s| {
-            let r = material_pixels(s, args);
+            let r = sample_pixels(s, args);
             bar.inc(1);
             r
         })
@@ -85,10 +128,11 @@ pub fn train(args: &TrainArgs) -> Result<bool, CliError> {
         classes.extend(c);
     }
     let summary = summary(args, samples.len());
-    let model = knn::fit(
+    let model = KnnModel::fit_balanced(
+        args.task.expect(),
+        usize::from(args.k),
         &points,
         &classes,
-        usize::from(args.k),
         args.max_points as usize,
         args.seed,
         summary,
@@ -107,20 +151,18 @@ pub fn train(args: &TrainArgs) -> Result<bool, CliError> {
     Ok(true)
 }
 
-/// Feature vectors and classes of one sample's labelled object pixels.
-fn material_pixels(sample: &Path, args: &TrainArgs) -> Result<(Vec<f32>, Vec<u8>), CliError> {
+/// Feature vectors and classes of one sample's labelled pixels.
+fn sample_pixels(sample: &Path, args: &TrainArgs) -> Result<(Vec<f32>, Vec<u8>), CliError> {
     let file = resolve(sample, args.input)?;
     let (obs, _) = read_observation(&file, &args.read)?;
     let gt = polar_io::read_ground_truth(sample, Validation::Check)?;
     let (mut points, mut classes) = (Vec::new(), Vec::new());
-    if let Some(labels) = &gt.material {
-        knn::add_training_pixels(&obs, labels, &mut points, &mut classes).map_err(|e| {
-            CliError::Task {
-                task: "material",
-                message: format!("{}: {e}", sample.display()),
-            }
+    args.task
+        .add_pixels(&obs, &gt, &mut points, &mut classes)
+        .map_err(|e| CliError::Task {
+            task: args.task.name(),
+            message: format!("{}: {e}", sample.display()),
         })?;
-    }
     Ok((points, classes))
 }
 

@@ -6,7 +6,7 @@ use polar_io::Y_CHANNEL;
 use polar_io::files::vision;
 use polar_material::{Classifier, MaterialOptions, classify};
 
-use super::{Context, Failure, Outcome, io, picture_path, to_json};
+use super::{Context, Failure, Outcome, io, knn_message, picture_path, to_json};
 use crate::pictures::{MATERIAL_PALETTE, label_picture};
 use crate::task_options::TaskArgs;
 
@@ -38,11 +38,7 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     .map_err(io)?;
     let mut outcome = Outcome::default();
     if let Classifier::Knn(m) = &clf {
-        outcome.messages.push(format!(
-            "kNN classifier: k = {}, {} training points",
-            m.model().header.k,
-            m.model().header.points
-        ));
+        outcome.messages.push(knn_message(m.model()));
     } else if ctx.normals.is_none() {
         outcome
             .messages

@@ -121,6 +121,12 @@ pub fn picture_path(out: &Path, name: &str) -> PathBuf {
     out.join(polar_io::files::vision::PICTURES).join(name)
 }
 
+/// The message a task run by a kNN model reports: its size.
+pub fn knn_message(model: &polar_learn::KnnModel) -> String {
+    let h = &model.header;
+    format!("kNN classifier: k = {}, {} training points", h.k, h.points)
+}
+
 /// Serializes task metrics for `metrics.json`.
 pub fn to_json(value: &impl serde::Serialize) -> Result<Value, CliError> {
     serde_json::to_value(value).map_err(|e| CliError::Json(e.to_string()))

@@ -6,15 +6,16 @@ use polar_eval::mask_metrics;
 use polar_image::Gray;
 use polar_io::files::vision;
 use polar_io::{MaterialLabel, Y_CHANNEL};
-use polar_transparency::{TransparencyOptions, detect};
+use polar_transparency::{Segmenter, TransparencyOptions, detect};
 
-use super::{Context, Failure, Outcome, io, picture_path, to_json};
+use super::{Context, Failure, Outcome, io, knn_message, picture_path, to_json};
 use crate::pictures::overlay_picture;
 use crate::task_options::TaskArgs;
 
 /// Runs the task; leaves the mask for `material`.
-pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> {
-    let map = detect(ctx.obs, &TransparencyOptions::default())
+pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
+    let segmenter = args.transparent_segmenter()?;
+    let map = detect(ctx.obs, &segmenter, &TransparencyOptions::default())
         .map_err(|e| Failure::CannotRun(e.to_string()))?;
     let out = ctx.out;
     polar_io::write_gray8_png(out.join(vision::TRANSPARENT), &map.mask).map_err(io)?;
@@ -26,6 +27,9 @@ pub fn run(ctx: &mut Context<'_>, _args: &TaskArgs) -> Result<Outcome, Failure> 
     )
     .map_err(io)?;
     let mut outcome = Outcome::default();
+    if let Segmenter::Knn(m) = &segmenter {
+        outcome.messages.push(knn_message(m.model()));
+    }
     if let Some(gt) = &ctx.gt.transparent {
         let opaque = ctx.gt.material.as_ref().map(opaque_objects);
         let m = mask_metrics(&map.mask, gt, opaque.as_ref())
