@@ -54,7 +54,9 @@ fn args() -> Args {
                 a.ior = v.parse().unwrap_or_else(|e| panic!("--ior {v}: {e}"));
             }
             "--help" | "-h" => {
-                println!("eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto]");
+                println!(
+                    "eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto]"
+                );
                 std::process::exit(0);
             }
             _ => a.root = s.into(),

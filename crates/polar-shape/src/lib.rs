@@ -45,8 +45,10 @@ use polar_image::{Gray, Image, NormalImage};
 use polar_sensor::Observation;
 use thiserror::Error;
 
-/// The refractive index used when none is given: typical plastics and glass (1.45–1.6);
-/// the zenith error for a true index in 1.3–1.8 stays within a few degrees below ~60°.
+/// The refractive index used when none is given (and where [`IorOption::Estimate`] finds
+/// too little evidence): typical plastics and glass (1.45–1.6). It is the default rather
+/// than the estimate because on rendered glossy objects the contour DoLP is diluted by
+/// specular light and the estimate strays further from the truth (docs/benchmarks.md).
 pub const DEFAULT_IOR: f64 = 1.5;
 
 /// Errors of shape from polarization.

@@ -10,7 +10,9 @@ use polar_sensor::{Observation, StokesPlanes};
 use crate::cues::Cues;
 use crate::local::choose;
 use crate::synth::{Kind, Scene, lambert, sphere_hit};
-use crate::{Integrator, IorOption, Method, ReflectionType, Shape, ShapeError, ShapeOptions, estimate_shape};
+use crate::{
+    Integrator, IorOption, Method, ReflectionType, Shape, ShapeError, ShapeOptions, estimate_shape,
+};
 
 const METHODS: [Method; 2] = [Method::Local, Method::Global];
 
@@ -646,7 +648,10 @@ fn light_fitted_to_a_lambertian_sphere() {
             let angle = fit.direction().unwrap().angle(&l).to_degrees();
             let ratio = fit.ambient / fit.strength();
             assert!(angle < 2.0, "{l:?}: direction off by {angle} degrees");
-            assert!((ratio - 0.2).abs() < 0.06, "{l:?}: ambient / strength {ratio}");
+            assert!(
+                (ratio - 0.2).abs() < 0.06,
+                "{l:?}: ambient / strength {ratio}"
+            );
         }
     }
 }
