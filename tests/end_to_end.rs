@@ -186,7 +186,7 @@ fn train_transparent_then_run_with_the_model() {
 
 #[test]
 fn shape_from_polarization_on_the_ci_shape_family() {
-    let (_dir, m) = eval("sfp", "sfp", "2");
+    let (dir, m) = eval("sfp", "sfp", "2");
     let mean = family_mean(&m, "sfp", "sfp", "normal.mean_deg");
     let median = family_mean(&m, "sfp", "sfp", "normal.median_deg");
     eprintln!("sfp ci: mean {mean:.2} deg, median {median:.2} deg");
@@ -194,6 +194,51 @@ fn shape_from_polarization_on_the_ci_shape_family() {
         median < SFP_CI_MEDIAN_DEG && mean < SFP_CI_MEAN_DEG,
         "mean {mean}, median {median}"
     );
+    worst_sfp_samples_are_shown(dir.path(), &m);
+}
+
+/// summary.md lists the sfp samples with the largest mean error, largest first, each with
+/// its picture (S0 | estimate | truth | error: four panels as wide as the sample), and
+/// every sample's metrics say which index was used and carry the fitted light.
+fn worst_sfp_samples_are_shown(out: &std::path::Path, m: &serde_json::Value) {
+    let mut by_error: Vec<(f64, String)> = m["samples"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .map(|(name, r)| {
+            let sfp = &r["Ok"]["tasks"]["sfp"]["metrics"];
+            assert_eq!(sfp["ior"]["source"], "default", "{name}");
+            assert!(sfp["light"]["direction"].is_array(), "{name}: {sfp}");
+            (sfp["normal"]["mean_deg"].as_f64().unwrap(), name.clone())
+        })
+        .collect();
+    by_error.sort_by(|a, b| b.0.total_cmp(&a.0));
+    by_error.truncate(5);
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    let section = summary
+        .split_once("largest mean angular error")
+        .expect("summary.md has the worst-samples section")
+        .1;
+    let listed: Vec<&str> = section
+        .lines()
+        .filter_map(|l| l.strip_prefix("| sfp-"))
+        .collect();
+    assert_eq!(listed.len(), by_error.len(), "{section}");
+    for (rank, ((_, name), line)) in by_error.iter().zip(&listed).enumerate() {
+        assert!(
+            format!("sfp-{line}").starts_with(&format!("{name} ")),
+            "{line}"
+        );
+        let picture = out.join(format!("pictures/worst-sfp-{}-{name}.png", rank + 1));
+        assert!(line.contains(&format!("worst-sfp-{}-{name}.png", rank + 1)));
+        let png = polar_io::read_rgb8_png(&picture).unwrap();
+        let normal: polar_image::NormalImage = polar_io::read_exr(
+            out.join("samples").join(name).join(vision::NORMAL),
+            polar_io::RGB_CHANNELS,
+        )
+        .unwrap();
+        assert_eq!(png.size(), (4 * normal.width(), normal.height()));
+    }
 }
 
 #[test]

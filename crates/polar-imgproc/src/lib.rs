@@ -36,7 +36,9 @@ pub use filter::{
 pub use guided::guided_filter;
 pub use label::{ComponentStats, Connectivity, component_stats, label};
 pub use median::{median_blur, median_blur_u8};
-pub use metrics::{AngularErrorStats, ConfusionMatrix, angular_error, iou, psnr, ssim, ssim_map};
+pub use metrics::{
+    AngularErrorStats, ConfusionMatrix, angular_error, angular_error_map, iou, psnr, ssim, ssim_map,
+};
 pub use morph::{MorphShape, close, dilate, erode, max_filter, min_filter, open};
 pub use polar_image::Border;
 pub use threshold::{threshold_otsu, threshold_otsu_u8};

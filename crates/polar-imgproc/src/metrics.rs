@@ -224,29 +224,7 @@ pub fn angular_error(
         .zip(truth.pixels().par_iter())
         .enumerate()
         .filter(|(i, _)| mask.is_none_or(|m| m.as_slice()[*i] != 0))
-        .filter_map(|(_, (a, b))| {
-            let a = a.map(f64::from);
-            let b = b.map(f64::from);
-            let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-            let cross = [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ];
-            let (na, nb) = (
-                a.iter().map(|v| v * v).sum::<f64>(),
-                b.iter().map(|v| v * v).sum::<f64>(),
-            );
-            (na > 0.0 && nb > 0.0).then(|| {
-                cross
-                    .iter()
-                    .map(|v| v * v)
-                    .sum::<f64>()
-                    .sqrt()
-                    .atan2(dot)
-                    .to_degrees()
-            })
-        })
+        .filter_map(|(_, (a, b))| normal_angle_deg(a, b))
         .collect();
     let n = angles.len();
     if n == 0 {
@@ -268,6 +246,60 @@ pub fn angular_error(
         pct_below_22_5: pct(22.5),
         pct_below_30: pct(30.0),
     }))
+}
+
+/// The angle (degrees) between two normals, `atan2(|a × b|, a · b)`; `None` where either
+/// has zero length (no surface).
+fn normal_angle_deg(a: &[f32; 3], b: &[f32; 3]) -> Option<f64> {
+    let a = a.map(f64::from);
+    let b = b.map(f64::from);
+    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    let (na, nb) = (
+        a.iter().map(|v| v * v).sum::<f64>(),
+        b.iter().map(|v| v * v).sum::<f64>(),
+    );
+    (na > 0.0 && nb > 0.0).then(|| {
+        cross
+            .iter()
+            .map(|v| v * v)
+            .sum::<f64>()
+            .sqrt()
+            .atan2(dot)
+            .to_degrees()
+    })
+}
+
+/// Per-pixel angle (degrees) between estimated and true normals, as [`angular_error`]
+/// scores them; NaN where `mask` (if given) is zero or either normal has zero length.
+pub fn angular_error_map(
+    est: &NormalImage,
+    truth: &NormalImage,
+    mask: Option<&Gray<u8>>,
+) -> Result<Gray<f32>, Error> {
+    same_size(est, truth)?;
+    if let Some(m) = mask {
+        same_size(est, m)?;
+    }
+    let data = est
+        .pixels()
+        .par_iter()
+        .zip(truth.pixels().par_iter())
+        .enumerate()
+        .map(|(i, (a, b))| {
+            let inside = mask.is_none_or(|m| m.as_slice()[i] != 0);
+            inside
+                .then(|| normal_angle_deg(a, b))
+                .flatten()
+                .map_or(f32::NAN, |v| v as f32)
+        })
+        .collect();
+    let (w, h) = est.size();
+    Ok(Gray::from_vec(w, h, data).expect("one angle per pixel"))
 }
 
 /// Intersection over union of two binary masks (non-zero = inside):
@@ -392,5 +424,28 @@ mod tests {
         );
         assert_eq!(iou(&t, &p).unwrap(), Some(1.0));
         assert!(ConfusionMatrix::from_labels(&t, &p, 2).is_err());
+    }
+
+    /// The map holds the angles the statistics average: 90° and 0° here (1e-6 for the
+    /// f32 output), NaN outside the mask and where a normal is missing.
+    #[test]
+    fn angular_error_map_matches_the_statistics() {
+        let est =
+            NormalImage::from_vec(3, 1, vec![1.0, 0.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0]).unwrap();
+        let gt =
+            NormalImage::from_vec(3, 1, vec![0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0]).unwrap();
+        let m = angular_error_map(&est, &gt, None).unwrap();
+        let v = m.as_slice();
+        assert!((v[0] - 90.0).abs() < 1e-6 && v[1].abs() < 1e-6 && v[2].is_nan());
+        let mean = angular_error(&est, &gt, None).unwrap().unwrap().mean;
+        assert!((f64::from(v[0] + v[1]) / 2.0 - mean).abs() < 1e-5);
+        let mask = Gray::from_vec(3, 1, vec![0u8, 1, 1]).unwrap();
+        assert!(
+            angular_error_map(&est, &gt, Some(&mask))
+                .unwrap()
+                .as_slice()[0]
+                .is_nan()
+        );
+        assert!(angular_error_map(&est, &gt, Some(&Gray::new(2, 1))).is_err());
     }
 }

@@ -102,6 +102,9 @@ pub mod files {
             pub const NORMAL: &str = "normal.png";
             /// Reflection types.
             pub const REFLECTION: &str = "reflection.png";
+            /// S0, estimated normals, true normals and angular error side by side (only
+            /// where the sample has `gt/normal.exr`).
+            pub const NORMAL_ERROR: &str = "normal_error.png";
             /// Material labels.
             pub const MATERIAL: &str = "material.png";
             /// Transparency overlay.

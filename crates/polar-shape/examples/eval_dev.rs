@@ -4,9 +4,12 @@
 //! mask and a "full" mean that scores missed object pixels as facing the camera.
 //!
 //! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]
-//! [--only TEXT] [--no-speed]` (default `/work/data/dev`; samples `sfp-*` and the Mitsuba
-//! task scenes `mts-shape-*`; `--only` keeps names containing TEXT, `--no-speed` skips the
-//! timing of upscaled frames). The Stokes planes come from the raw mosaic (residual
+//! [--only TEXT] [--no-speed] [--ior N|auto]` (default `/work/data/dev`; samples `sfp-*` and
+//! the Mitsuba task scenes `mts-shape-*`; `--only` keeps names containing TEXT, `--no-speed`
+//! skips the timing of upscaled frames, `--ior` as `polar-vision run --ior`, default 1.5).
+//! Each line also gives the index used and its source, and the true indices of the
+//! sample's objects from its meta.json (read here for evaluation only), and the light
+//! fitted to the shading (direction in the camera frame, strength, ambient). The Stokes planes come from the raw mosaic (residual
 //! demosaicing, saturation flagged) as a camera would give them; `--exr` uses
 //! `stokes.exr` instead. `--debug DIR` writes foreground / reflection / error pictures.
 
@@ -18,7 +21,7 @@ use polar_imgproc::angular_error;
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::mask::validity_mask;
 use polar_sensor::{DemosaicMethod, Observation, StokesPlanes, stokes_planes};
-use polar_shape::{Integrator, Method, ShapeOptions, estimate_shape};
+use polar_shape::{Integrator, IorOption, Method, ShapeOptions, estimate_shape};
 
 struct Args {
     root: PathBuf,
@@ -27,6 +30,7 @@ struct Args {
     /// Only samples whose name contains this.
     only: Option<String>,
     speed: bool,
+    ior: IorOption,
 }
 
 fn args() -> Args {
@@ -36,6 +40,7 @@ fn args() -> Args {
         debug: None,
         only: None,
         speed: true,
+        ior: IorOption::Default,
     };
     let mut it = std::env::args().skip(1);
     while let Some(s) = it.next() {
@@ -44,6 +49,16 @@ fn args() -> Args {
             "--debug" => a.debug = it.next().map(PathBuf::from),
             "--only" => a.only = it.next(),
             "--no-speed" => a.speed = false,
+            "--ior" => {
+                let v = it.next().unwrap_or_default();
+                a.ior = v.parse().unwrap_or_else(|e| panic!("--ior {v}: {e}"));
+            }
+            "--help" | "-h" => {
+                println!(
+                    "eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto]"
+                );
+                std::process::exit(0);
+            }
             _ => a.root = s.into(),
         }
     }
@@ -122,12 +137,19 @@ fn main() {
         )
         .unwrap();
         let name = dir.file_name().unwrap().to_string_lossy().to_string();
-        let mut line = format!("{name} {noise:9}");
+        let true_iors: Vec<String> = s.meta["scene"]["objects"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|o| o["material"]["ior"].as_f64())
+            .map(|n| format!("{n:.3}"))
+            .collect();
+        let mut line = format!("{name} {noise:9} true n [{}]", true_iors.join(" "));
         for m in methods {
             let opts = ShapeOptions {
                 method: m,
                 integrator: Integrator::Poisson,
-                ior: None,
+                ior: a.ior,
             };
             let t = Instant::now();
             let shape = estimate_shape(&obs, &opts).unwrap();
@@ -139,6 +161,20 @@ fn main() {
                 .unwrap()
                 .unwrap_or(0.0);
             e.ious.push(iou);
+            if m == Method::Local {
+                let light = shape.light.map_or("none".into(), |l| {
+                    let d = l.direction().unwrap_or_default();
+                    format!(
+                        "({:.2} {:.2} {:.2}) x{:.2} + {:.2}",
+                        d.x,
+                        d.y,
+                        d.z,
+                        l.strength(),
+                        l.ambient
+                    )
+                });
+                line += &format!(" | n {:.3} {} | light {light}", shape.ior, shape.ior_source);
+            }
             e.secs += secs;
             if let Some(st) = st {
                 e.means.push(st.mean);
@@ -334,7 +370,7 @@ fn speed(dir: &Path) {
                 let opts = ShapeOptions {
                     method: m,
                     integrator: integ,
-                    ior: None,
+                    ior: IorOption::Default,
                 };
                 let t = Instant::now();
                 estimate_shape(&obs, &opts).unwrap();

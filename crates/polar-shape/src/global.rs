@@ -28,19 +28,23 @@ use polar_image::Gray;
 
 use crate::cues::{Cues, HIGHLIGHT};
 use crate::integrate::{MAX_SLOPE, finish, slopes, solve_spd};
-use crate::{Estimate, Integrator, ReflectionType, ShapeError, local};
+use crate::{Estimate, ReflectionType, ShapeError};
 
 /// Weight of the pull toward the local method's slopes.
 const LOCAL_WEIGHT: f64 = 0.05;
 /// Weight of a shading row relative to an azimuth row.
 const SHADING_WEIGHT: f64 = 2.0;
 
-/// Normals and depth by the global method. `_integrator` is unused: the depth is the
-/// solution itself.
-pub fn solve(cues: &Cues, fg: &[bool], _integrator: Integrator) -> Result<Estimate, ShapeError> {
-    let local = local::disambiguate(cues, fg)?;
+/// Normals and depth by the global method from the local method's estimate `local` and
+/// the light fitted to it ([`fit_light`]).
+pub fn solve(
+    cues: &Cues,
+    fg: &[bool],
+    local: Estimate,
+    light: Option<&Light>,
+) -> Result<Estimate, ShapeError> {
     let (w, h) = (cues.width, cues.height);
-    let light = fit_light(cues, fg, &local);
+    let light = light.map(|l| (l.scaled_direction, l.ambient));
     let (p_loc, q_loc) = slopes(&local.normals, fg);
     let mut index = vec![usize::MAX; w * h];
     let mut count = 0;
@@ -136,9 +140,35 @@ fn azimuth_direction(cues: &Cues, k: usize, kind: ReflectionType) -> Vector3<f64
         .unwrap_or_else(Vector3::x)
 }
 
-/// Least-squares Lambertian light `b` (albedo times direction) and ambient `a` with
-/// `s ≈ b·n + a`, over confidently lit diffuse pixels; `None` without enough pixels.
-pub fn fit_light(cues: &Cues, fg: &[bool], local: &Estimate) -> Option<(Vector3<f64>, f64)> {
+/// A distant light and ambient term fitted to the image: `s ≈ b·n + a` (Lambert), with `s`
+/// the S0 normalised by the observation's robust scale ([`Cues::s0n`]) and `n` the normal.
+/// Albedo and irradiance enter only as their product, so `|b|` is albedo × irradiance in
+/// that unit, and `a` the albedo-weighted ambient light in the same unit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// `b`: the unit direction toward the light (camera frame) times the strength.
+    pub scaled_direction: Vector3<f64>,
+    /// `a`: the light reaching every pixel whatever its normal.
+    pub ambient: f64,
+}
+
+impl Light {
+    /// Unit direction toward the light in the camera frame (x right, y up, z toward the
+    /// camera); `None` for a zero fit.
+    pub fn direction(&self) -> Option<Vector3<f64>> {
+        self.scaled_direction.try_normalize(1e-12)
+    }
+
+    /// `|b|`: albedo × irradiance in units of the observation's robust S0 scale.
+    pub fn strength(&self) -> f64 {
+        self.scaled_direction.norm()
+    }
+}
+
+/// Least-squares Lambertian [`Light`] over confidently lit diffuse pixels of the local
+/// estimate, a second pass without residuals beyond 2.5 median absolute residuals
+/// (shadows, highlights); `None` without enough pixels.
+pub fn fit_light(cues: &Cues, fg: &[bool], local: &Estimate) -> Option<Light> {
     let usable: Vec<usize> = (0..cues.len())
         .filter(|&k| {
             fg[k]
@@ -164,7 +194,10 @@ pub fn fit_light(cues: &Cues, fg: &[bool], local: &Estimate) -> Option<(Vector3<
         }
         let x = ata.try_inverse()? * atb;
         let (b, a) = (Vector3::new(x[0], x[1], x[2]), x[3]);
-        fit = Some((b, a));
+        fit = Some(Light {
+            scaled_direction: b,
+            ambient: a,
+        });
         let res: Vec<f64> = usable
             .iter()
             .map(|&k| (f64::from(cues.s0n[k]) - b.dot(&local.normals[k]) - a).abs())

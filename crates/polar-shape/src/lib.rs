@@ -15,6 +15,11 @@
 //!    sparse linear least-squares problem for the height, [`global`]).
 //! 5. Depth from the normals ([`integrate`]): Frankot–Chellappa or a masked Poisson solve.
 //!
+//! Alongside: the refractive index, given, estimated from the DoLP profile at the
+//! occluding contours ([`ior`], with [`IorOption::Estimate`]) or [`DEFAULT_IOR`]
+//! ([`IorSource`] says which and why), and the Lambertian light and ambient fitted to the
+//! shading over the local method's normals ([`global::Light`]).
+//!
 //! Output conventions follow `gt/normal.exr`: `(x, y, z)` in the camera frame (x right,
 //! y up, z toward the camera), `0, 0, 0` where there is no estimate. Depth is relative
 //! (see [`integrate`]): NaN outside the foreground.
@@ -23,6 +28,7 @@ pub mod cues;
 pub mod foreground;
 pub mod global;
 pub mod integrate;
+pub mod ior;
 pub mod local;
 pub mod zenith;
 
@@ -39,8 +45,10 @@ use polar_image::{Gray, Image, NormalImage};
 use polar_sensor::Observation;
 use thiserror::Error;
 
-/// The refractive index used when none is given: typical plastics and glass (1.45–1.6);
-/// the zenith error for a true index in 1.3–1.8 stays within a few degrees below ~60°.
+/// The refractive index used when none is given (and where [`IorOption::Estimate`] finds
+/// too little evidence): typical plastics and glass (1.45–1.6). It is the default rather
+/// than the estimate because on rendered glossy objects the contour DoLP is diluted by
+/// specular light and the estimate strays further from the truth (docs/benchmarks.md).
 pub const DEFAULT_IOR: f64 = 1.5;
 
 /// Errors of shape from polarization.
@@ -146,8 +154,8 @@ pub struct ShapeOptions {
     /// Depth integrator of the local method (the global method's depth is its own
     /// least-squares solution, so it ignores this).
     pub integrator: Integrator,
-    /// Relative refractive index of the objects; [`DEFAULT_IOR`] when `None`.
-    pub ior: Option<f64>,
+    /// How the relative refractive index of the objects is chosen.
+    pub ior: IorOption,
 }
 
 impl Default for ShapeOptions {
@@ -155,7 +163,74 @@ impl Default for ShapeOptions {
         Self {
             method: Method::Local,
             integrator: Integrator::Poisson,
-            ior: None,
+            ior: IorOption::Default,
+        }
+    }
+}
+
+/// How the refractive index is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum IorOption {
+    /// [`DEFAULT_IOR`].
+    #[default]
+    Default,
+    /// This index (a finite number above 1).
+    Given(f64),
+    /// Estimated from the image ([`ior::estimate_ior`]), else [`DEFAULT_IOR`].
+    Estimate,
+}
+
+impl FromStr for IorOption {
+    type Err = ShapeError;
+    /// `auto` or a number.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s == "auto" {
+            return Ok(IorOption::Estimate);
+        }
+        match s.parse::<f64>() {
+            Ok(n) if n.is_finite() && n > 1.0 => Ok(IorOption::Given(n)),
+            Ok(n) => Err(ShapeError::InvalidIor(n)),
+            Err(_) => Err(ShapeError::UnknownName {
+                kind: "refractive index",
+                name: s.into(),
+                known: "a number > 1, auto",
+            }),
+        }
+    }
+}
+
+/// Where the index of a [`Shape`] came from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum IorSource {
+    /// Given by the caller.
+    Given,
+    /// Estimated from the image.
+    Estimated(ior::IorEstimate),
+    /// [`DEFAULT_IOR`], with the reason (not asked for, or too little evidence).
+    Default(String),
+}
+
+impl fmt::Display for IorSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            IorSource::Given => f.write_str("given"),
+            IorSource::Estimated(e) => write!(
+                f,
+                "estimated from {} contour pixels (fit {:.3})",
+                e.pixels, e.unclamped
+            ),
+            IorSource::Default(why) => write!(f, "default ({why})"),
+        }
+    }
+}
+
+impl IorSource {
+    /// `given`, `estimated` or `default`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            IorSource::Given => "given",
+            IorSource::Estimated(_) => "estimated",
+            IorSource::Default(_) => "default",
         }
     }
 }
@@ -190,6 +265,11 @@ pub struct Shape {
     pub foreground: Gray<u8>,
     /// The refractive index used.
     pub ior: f64,
+    /// Where [`Shape::ior`] came from.
+    pub ior_source: IorSource,
+    /// The light fitted to the shading ([`global::fit_light`]), `None` without enough
+    /// lit diffuse pixels.
+    pub light: Option<global::Light>,
 }
 
 /// Normals, depth, confidence and reflection types of one observation.
@@ -201,15 +281,25 @@ pub fn estimate_shape(obs: &Observation, opts: &ShapeOptions) -> Result<Shape, S
     if w == 0 || h == 0 {
         return Err(ShapeError::Empty(w, h));
     }
-    let ior = opts.ior.unwrap_or(DEFAULT_IOR);
-    if !(ior.is_finite() && ior > 1.0) {
-        return Err(ShapeError::InvalidIor(ior));
+    let given = match opts.ior {
+        IorOption::Given(n) => n,
+        IorOption::Default | IorOption::Estimate => DEFAULT_IOR,
+    };
+    if !(given.is_finite() && given > 1.0) {
+        return Err(ShapeError::InvalidIor(given));
     }
-    let cues = cues::Cues::new(obs, ior)?;
+    // The foreground does not depend on the index, so the index can be estimated on it.
+    let mut cues = cues::Cues::new(obs, given)?;
     let fg = foreground::foreground(&cues)?;
+    let (ior, ior_source) = choose_ior(&cues, &fg, opts.ior)?;
+    if ior != given {
+        cues.models = zenith::ZenithModels::new(ior);
+    }
+    let local = local::disambiguate(&cues, &fg)?;
+    let light = global::fit_light(&cues, &fg, &local);
     let est = match opts.method {
-        Method::Local => local::disambiguate(&cues, &fg)?,
-        Method::Global => global::solve(&cues, &fg, opts.integrator)?,
+        Method::Local => local,
+        Method::Global => global::solve(&cues, &fg, local, light.as_ref())?,
     };
     let depth = match (opts.method, &est.depth) {
         (Method::Global, Some(d)) => d.clone(),
@@ -231,6 +321,24 @@ pub fn estimate_shape(obs: &Observation, opts: &ShapeOptions) -> Result<Shape, S
         foreground: Gray::from_vec(w, h, fg.iter().map(|&f| if f { 255 } else { 0 }).collect())
             .expect("sized"),
         ior,
+        ior_source,
+        light,
+    })
+}
+
+/// The index and its source for `option`.
+fn choose_ior(
+    cues: &cues::Cues,
+    fg: &[bool],
+    option: IorOption,
+) -> Result<(f64, IorSource), ShapeError> {
+    Ok(match option {
+        IorOption::Given(n) => (n, IorSource::Given),
+        IorOption::Default => (DEFAULT_IOR, IorSource::Default("no index given".into())),
+        IorOption::Estimate => match ior::estimate_ior(cues, fg)? {
+            Ok(e) => (e.ior, IorSource::Estimated(e)),
+            Err(why) => (DEFAULT_IOR, IorSource::Default(why)),
+        },
     })
 }
 

@@ -206,15 +206,7 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
         });
     }
     let radius = component_max(fg, &dist, w, h)?;
-    let smooth = {
-        let src =
-            Gray::from_vec(w, h, dist.iter().map(|&d| d.min(1e6) as f32).collect()).expect("sized");
-        let mut dst = Gray::new(w, h);
-        gaussian_blur(&src, &mut dst, 0, 1.0)?;
-        dst
-    };
-    let s = smooth.as_slice();
-    let at = |x: usize, y: usize| f64::from(s[y * w + x]);
+    let outward = outward_directions(&dist, w, h)?;
     let out: Vec<(Vector3<f64>, f64)> = (0..n)
         .into_par_iter()
         .map(|k| {
@@ -222,15 +214,13 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
             if !fg[k] {
                 return (-f.d, 0.0);
             }
-            let (x, y) = (k % w, k / w);
-            let gx = at((x + 1).min(w - 1), y) - at(x.saturating_sub(1), y);
-            let gy = at(x, (y + 1).min(h - 1)) - at(x, y.saturating_sub(1));
+            let (dx, dy) = outward[k];
             let r = radius[k].max(1.0);
             let sin_z = (1.0 - (dist[k] - 0.5).max(0.0) / r).clamp(0.0, 1.0);
-            if gx.hypot(gy) < 1e-6 {
+            if dx.hypot(dy) < 1e-6 {
                 return (-f.d, 0.0);
             }
-            let az = image_direction_angle(&f, -gx, -gy);
+            let az = image_direction_angle(&f, dx, dy);
             (f.normal(az, sin_z.asin()), sin_z * sin_z)
         })
         .collect();
@@ -238,6 +228,27 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
         normal: out.iter().map(|v| v.0).collect(),
         weight: out.iter().map(|v| v.1).collect(),
     })
+}
+
+/// Outward directions `(−∂D/∂x, −∂D/∂y)` (image axes, y down, not normalised) of the
+/// distance map `D` ([`distance_to_background`]) smoothed by a Gaussian of 1 pixel,
+/// by central differences: away from the object, across its nearest contour.
+pub fn outward_directions(dist: &[f64], w: usize, h: usize) -> Result<Vec<(f64, f64)>, ShapeError> {
+    let src =
+        Gray::from_vec(w, h, dist.iter().map(|&d| d.min(1e6) as f32).collect()).expect("sized");
+    let mut smooth = Gray::new(w, h);
+    gaussian_blur(&src, &mut smooth, 0, 1.0)?;
+    let s = smooth.as_slice();
+    let at = |x: usize, y: usize| f64::from(s[y * w + x]);
+    Ok((0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            let gx = at((x + 1).min(w - 1), y) - at(x.saturating_sub(1), y);
+            let gy = at(x, (y + 1).min(h - 1)) - at(x, y.saturating_sub(1));
+            (-gx, -gy)
+        })
+        .collect())
 }
 
 /// Per foreground pixel, the largest distance in its 8-connected component.

@@ -143,9 +143,14 @@ pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
             .collect::<Result<_, _>>()
     })?;
     bar.finish_and_clear();
+    let dirs = records
+        .iter()
+        .map(|(n, _)| (n.clone(), out.join("samples").join(n)))
+        .collect();
     let report = write_report(
         out,
         records.into_iter().map(|(n, r)| (n, r.result)).collect(),
+        &dirs,
     )?;
     print_failures(&report);
     Ok(report
@@ -168,12 +173,14 @@ pub struct MergeArgs {
 /// Joins the per-sample records of shard folders into one report.
 pub fn merge(args: &MergeArgs) -> Result<bool, CliError> {
     let mut samples = BTreeMap::new();
+    let mut dirs = BTreeMap::new();
     let mut options: Option<String> = None;
     for dir in &args.shards {
         for (name, record) in read_records(dir)? {
             if options.get_or_insert_with(|| record.options.clone()) != &record.options {
                 return Err(CliError::MergeOptions(dir.join("samples").join(&name)));
             }
+            dirs.insert(name.clone(), dir.join("samples").join(&name));
             samples.insert(name, record.result);
         }
     }
@@ -181,7 +188,7 @@ pub fn merge(args: &MergeArgs) -> Result<bool, CliError> {
         return Err(CliError::NoSamples(args.shards[0].clone()));
     }
     prepare_resumable(&args.out)?;
-    let report = write_report(&args.out, samples)?;
+    let report = write_report(&args.out, samples, &dirs)?;
     print_failures(&report);
     Ok(report.samples.values().all(Result::is_ok))
 }
@@ -267,9 +274,12 @@ fn read_records(dir: &Path) -> Result<Vec<(String, Record)>, CliError> {
     Ok(out)
 }
 
+/// Writes metrics.json and summary.md into `out`, with the pictures of the worst sfp
+/// samples copied from their output folders `dirs` (sample name -> folder).
 fn write_report(
     out: &Path,
     samples: BTreeMap<String, Result<SampleReport, String>>,
+    dirs: &BTreeMap<String, PathBuf>,
 ) -> Result<EvalReport, CliError> {
     let ok: BTreeMap<String, BTreeMap<String, Summary>> = samples
         .iter()
@@ -281,7 +291,9 @@ fn write_report(
         samples,
     };
     polar_io::write_json(out.join(files::vision::METRICS), &report)?;
-    let summary = summary_markdown(&report);
+    let worst = worst_sfp(&report);
+    let pictures = copy_worst_pictures(out, dirs, &worst)?;
+    let summary = summary_markdown(&report) + &worst_markdown(&worst, &pictures);
     std::fs::write(out.join("summary.md"), summary)
         .map_err(|e| CliError::write(out.join("summary.md"), e))?;
     Ok(report)
@@ -352,6 +364,107 @@ pub fn summary_markdown(report: &EvalReport) -> String {
                 let _ = writeln!(s, "{head} {label} | {v:.4} |");
             }
         }
+    }
+    s
+}
+
+/// How many sfp samples summary.md shows as the worst.
+pub const WORST_SFP: usize = 5;
+
+/// The sfp metrics (`normal` of `metrics.json`) of the [`WORST_SFP`] samples with the
+/// largest mean angular error, largest first.
+pub fn worst_sfp(report: &EvalReport) -> Vec<(&str, &serde_json::Value)> {
+    let mut scored: Vec<(&str, &serde_json::Value, f64)> = report
+        .samples
+        .iter()
+        .filter_map(|(name, r)| {
+            let metrics = r.as_ref().ok()?.tasks.get("sfp")?.metrics.as_ref()?;
+            let mean = metrics["normal"]["mean_deg"].as_f64()?;
+            Some((name.as_str(), metrics, mean))
+        })
+        .collect();
+    scored.sort_by(|a, b| b.2.total_cmp(&a.2).then(a.0.cmp(b.0)));
+    scored
+        .into_iter()
+        .take(WORST_SFP)
+        .map(|(n, m, _)| (n, m))
+        .collect()
+}
+
+/// Copies each worst sample's error picture to `OUT/pictures/worst-sfp-<rank>-<name>.png`
+/// (after removing those of an earlier report); the relative paths, `None` where a sample
+/// has no picture.
+fn copy_worst_pictures(
+    out: &Path,
+    dirs: &BTreeMap<String, PathBuf>,
+    worst: &[(&str, &serde_json::Value)],
+) -> Result<Vec<Option<String>>, CliError> {
+    let folder = out.join(files::vision::PICTURES);
+    if let Ok(entries) = std::fs::read_dir(&folder) {
+        for e in entries.flatten() {
+            if e.file_name().to_string_lossy().starts_with("worst-sfp-") {
+                std::fs::remove_file(e.path()).map_err(|err| CliError::write(e.path(), err))?;
+            }
+        }
+    }
+    let mut paths = Vec::new();
+    for (rank, (name, _)) in worst.iter().enumerate() {
+        let src = dirs.get(*name).map(|d| {
+            d.join(files::vision::PICTURES)
+                .join(files::vision::pictures::NORMAL_ERROR)
+        });
+        let Some(src) = src.filter(|p| p.is_file()) else {
+            paths.push(None);
+            continue;
+        };
+        std::fs::create_dir_all(&folder).map_err(|e| CliError::write(&folder, e))?;
+        let rel = format!(
+            "{}/worst-sfp-{}-{name}.png",
+            files::vision::PICTURES,
+            rank + 1
+        );
+        std::fs::copy(&src, out.join(&rel)).map_err(|e| CliError::write(out.join(&rel), e))?;
+        paths.push(Some(rel));
+    }
+    Ok(paths)
+}
+
+/// The summary.md section of the worst sfp samples: their figures per reflection type
+/// and their pictures.
+fn worst_markdown(worst: &[(&str, &serde_json::Value)], pictures: &[Option<String>]) -> String {
+    if worst.is_empty() {
+        return String::new();
+    }
+    let mut s = format!(
+        "\n## sfp: the {} samples with the largest mean angular error\n\n\
+Mean angular error (deg) over object pixels, overall and per reflection type the method chose \
+(a type's error says where it fails: wrong azimuth from a specular/diffuse mix-up, wrong zenith \
+from the index or dilution). Pictures: S0 | estimated normals | true normals | angular error \
+(viridis, 0 to 90 deg).\n\n\
+| sample | mean | median | diffuse | specular | mixed | none | index | picture |\n\
+|---|---|---|---|---|---|---|---|---|\n",
+        worst.len()
+    );
+    let num = |v: &serde_json::Value| v.as_f64().map_or("-".into(), |x| format!("{x:.1}"));
+    for ((name, m), picture) in worst.iter().zip(pictures) {
+        let n = &m["normal"];
+        let by_type = &n["mean_deg_by_type"];
+        let index = m["ior"]["value"].as_f64().map_or("-".into(), |v| {
+            format!("{v:.3} ({})", m["ior"]["source"].as_str().unwrap_or("?"))
+        });
+        let pic = picture
+            .as_ref()
+            .map_or("-".into(), |p| format!("![{name}]({p})"));
+        let _ = writeln!(
+            s,
+            "| {name} | {} | {} | {} | {} | {} | {} | {index} | {pic} |",
+            num(&n["mean_deg"]),
+            num(&n["median_deg"]),
+            num(&by_type["diffuse"]),
+            num(&by_type["specular"]),
+            num(&by_type["mixed"]),
+            num(&by_type["none"]),
+        );
     }
     s
 }

@@ -33,18 +33,45 @@ pub const MATERIAL_PALETTE: [[u8; 3]; 4] = [
     [60, 220, 230],
 ];
 
-/// S0 as grey (0 to its 99.5th percentile) with `mask` (non-zero) tinted red.
-pub fn overlay_picture(s0: &Gray<f32>, mask: &Gray<u8>) -> Image<u8, 3> {
+/// S0 as grey levels in `[0, 255]`, from 0 to its 99.5th percentile (non-finite: 0).
+fn grey_levels(s0: &Gray<f32>) -> impl Iterator<Item = f32> + '_ {
     let top = quantile(s0.as_slice().iter().copied(), 0.995)
         .filter(|&q| q > 0.0)
         .unwrap_or(1.0);
-    let grey = |v: f32| (v / top).clamp(0.0, 1.0) * 255.0;
-    let data: Vec<[u8; 3]> = s0
-        .as_slice()
-        .iter()
+    s0.as_slice().iter().map(move |&v| {
+        if v.is_finite() {
+            (v / top).clamp(0.0, 1.0) * 255.0
+        } else {
+            0.0
+        }
+    })
+}
+
+/// Largest angular error (degrees) on the error scale of [`normal_error_picture`].
+pub const ERROR_SCALE_DEG: f32 = 90.0;
+
+/// S0 (grey), estimated normals, true normals ([`normal_picture`]) and the angular error
+/// `error` (degrees, viridis from 0 to [`ERROR_SCALE_DEG`], black where NaN), side by side.
+pub fn normal_error_picture(
+    s0: &Gray<f32>,
+    est: &NormalImage,
+    truth: &NormalImage,
+    error: &Gray<f32>,
+) -> Image<u8, 3> {
+    let grey = from_pixels(s0.size(), grey_levels(s0).map(|g| [g as u8; 3]).collect());
+    hstack(&[
+        grey,
+        normal_picture(est),
+        normal_picture(truth),
+        colormap(error, 0.0, ERROR_SCALE_DEG),
+    ])
+}
+
+/// S0 as grey (0 to its 99.5th percentile) with `mask` (non-zero) tinted red.
+pub fn overlay_picture(s0: &Gray<f32>, mask: &Gray<u8>) -> Image<u8, 3> {
+    let data: Vec<[u8; 3]> = grey_levels(s0)
         .zip(mask.as_slice())
-        .map(|(&v, &m)| {
-            let g = if v.is_finite() { grey(v) } else { 0.0 };
+        .map(|(g, &m)| {
             if m != 0 {
                 [(0.5 * g + 127.0) as u8, (0.5 * g) as u8, (0.5 * g) as u8]
             } else {
@@ -65,10 +92,15 @@ pub fn side_by_side(same_scale: &[&Gray<f32>], extra: Option<&Gray<f32>>) -> Ima
         .unwrap_or(1.0);
     let mut parts: Vec<Image<u8, 3>> = same_scale.iter().map(|g| colormap(g, 0.0, top)).collect();
     parts.extend(extra.map(|g| colormap(g, 0.0, 1.0)));
+    hstack(&parts)
+}
+
+/// Pictures of one size side by side, left to right.
+fn hstack(parts: &[Image<u8, 3>]) -> Image<u8, 3> {
     let (w, h) = parts.first().map_or((0, 0), |p| p.size());
     let mut data = Vec::with_capacity(w * h * parts.len());
     for y in 0..h {
-        for p in &parts {
+        for p in parts {
             data.extend_from_slice(&p.pixels()[y * w..(y + 1) * w]);
         }
     }
@@ -96,6 +128,21 @@ mod tests {
         let n = NormalImage::from_vec(2, 1, vec![0.0, 0.0, 1.0, 0.0, 0.0, 0.0]).unwrap();
         let p = normal_picture(&n);
         assert_eq!(p.pixels(), &[[128, 128, 255], [0, 0, 0]]);
+    }
+
+    /// Four panels; the error panel is black where there is no error and the top of the
+    /// scale where the error reaches it.
+    #[test]
+    fn normal_error_picture_has_four_panels() {
+        let n = NormalImage::from_vec(2, 1, vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0]).unwrap();
+        let s0 = Gray::from_vec(2, 1, vec![1.0f32, 0.0]).unwrap();
+        let err = Gray::from_vec(2, 1, vec![f32::NAN, ERROR_SCALE_DEG]).unwrap();
+        let p = normal_error_picture(&s0, &n, &n, &err);
+        assert_eq!(p.size(), (8, 1));
+        assert_eq!(p.pixels()[0], [255; 3]);
+        assert_eq!(p.pixels()[2], [128, 128, 255]);
+        assert_eq!(p.pixels()[6], [0; 3]);
+        assert_eq!(p.pixels()[7], polar_sensor::picture::viridis(1.0));
     }
 
     #[test]

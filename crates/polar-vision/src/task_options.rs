@@ -10,7 +10,7 @@ use polar_transparency::{Method as TransparentMethod, Segmenter};
 
 use crate::error::CliError;
 use polar_dehaze::Method as DehazeMethod;
-use polar_shape::{Integrator, Method};
+use polar_shape::{Integrator, IorOption, Method};
 
 use crate::tasks::{Context, Failure, Outcome, Task};
 
@@ -23,10 +23,12 @@ pub struct TaskArgs {
     /// the corners of a wide-angle view).
     #[arg(long, value_name = "DEG", value_parser = parse_fov)]
     pub fov: Option<f64>,
-    /// Refractive index of the objects (sfp, material). Default: estimated where the image
-    /// allows, else 1.5.
-    #[arg(long, value_name = "N", value_parser = parse_ior)]
-    pub ior: Option<f64>,
+    /// Refractive index of the objects (sfp): a number, or `auto` to estimate it from the
+    /// diffuse DoLP profile at the occluding contours (1.5 with the reason where the image
+    /// gives too little evidence). Default: 1.5; `auto` is opt-in, as on our own renders it
+    /// is less accurate than 1.5 (docs/benchmarks.md).
+    #[arg(long, value_name = "N|auto", value_parser = parse_ior)]
+    pub ior: Option<IorOption>,
     /// Shape from polarization, how the azimuth ambiguity is resolved:
     ///   local   occluding-boundary propagation with a convexity prior (fast)
     ///   global  height from polarization and shading as one sparse least squares
@@ -184,10 +186,15 @@ fn parse_fov(s: &str) -> Result<f64, String> {
     }
 }
 
-fn parse_ior(s: &str) -> Result<f64, String> {
-    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+fn parse_ior(s: &str) -> Result<IorOption, String> {
+    if s == "auto" {
+        return Ok(IorOption::Estimate);
+    }
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{s:?} is neither a number nor `auto`"))?;
     if (1.0..=4.0).contains(&v) && v > 1.0 {
-        Ok(v)
+        Ok(IorOption::Given(v))
     } else {
         Err(format!("{v} is not a refractive index in (1, 4]"))
     }

@@ -1,13 +1,17 @@
 //! `sfp`: shape from polarization (polar-shape) -> normal.exr, depth.exr,
-//! normal_confidence.exr, reflection.png and pictures; normal and depth metrics.
+//! normal_confidence.exr, reflection.png and pictures; with ground truth, the normal and
+//! depth metrics, the index used and its source, the fitted light, and a picture of the
+//! errors (S0 | estimate | truth | angular error).
 
 use polar_eval::normal_metrics;
+use polar_imgproc::angular_error_map;
 use polar_io::files::vision;
 use polar_io::{RGB_CHANNELS, Y_CHANNEL};
+use polar_shape::global::Light;
 use polar_shape::{Shape, ShapeOptions, estimate_shape};
 
 use super::{Context, Failure, Outcome, io, object_mask, picture_path, to_json};
-use crate::pictures::{REFLECTION_PALETTE, label_picture, normal_picture};
+use crate::pictures::{REFLECTION_PALETTE, label_picture, normal_error_picture, normal_picture};
 use crate::task_options::TaskArgs;
 
 /// Names of the reflection types, index = value of reflection.png.
@@ -18,7 +22,7 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     let opts = ShapeOptions {
         method: args.sfp_method,
         integrator: args.integrator,
-        ior: args.ior,
+        ior: args.ior.unwrap_or_default(),
     };
     let shape = estimate_shape(ctx.obs, &opts).map_err(|e| Failure::CannotRun(e.to_string()))?;
     write(ctx, &shape)?;
@@ -30,18 +34,55 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
         .filter(|&&v| v != 0)
         .count();
     outcome.messages.push(format!(
-        "{} with index {:.3}; {objects} pixels on objects",
-        opts.method, shape.ior
+        "{} with index {:.3}, {}; {}; {objects} pixels on objects",
+        opts.method,
+        shape.ior,
+        shape.ior_source,
+        light_message(shape.light.as_ref())
     ));
     if let (Some(gt_n), Some(objects)) = (&ctx.gt.normal, object_mask(ctx.gt)) {
         let types = Some((&shape.reflection, REFLECTION_NAMES.as_slice()));
         let depth = ctx.gt.depth.as_ref().map(|d| (&shape.depth, d));
         let m = normal_metrics(&shape.normal, gt_n, &objects, types, depth)
             .map_err(|e| Failure::CannotRun(e.to_string()))?;
-        outcome.metrics = Some(to_json(&serde_json::json!({ "normal": m }))?);
+        outcome.metrics = Some(to_json(&serde_json::json!({
+            "normal": m,
+            "ior": { "value": shape.ior, "source": shape.ior_source.name() },
+            "light": shape.light.map(|l| serde_json::json!({
+                "direction": l.direction().map(|d| [d.x, d.y, d.z]),
+                "strength": l.strength(),
+                "ambient": l.ambient,
+            })),
+        }))?);
+        let error = angular_error_map(&shape.normal, gt_n, Some(&objects))
+            .map_err(|e| Failure::CannotRun(e.to_string()))?;
+        let picture = normal_error_picture(&ctx.obs.planes.s0, &shape.normal, gt_n, &error);
+        polar_io::write_rgb8_png(
+            picture_path(ctx.out, vision::pictures::NORMAL_ERROR),
+            &picture,
+        )
+        .map_err(io)?;
     }
     ctx.normals = Some(shape.normal);
     Ok(outcome)
+}
+
+/// The fitted light for the run's messages: direction toward the light in the camera
+/// frame, strength (albedo × irradiance) and ambient, both in units of the frame's robust
+/// S0 scale.
+fn light_message(light: Option<&Light>) -> String {
+    let Some(l) = light else {
+        return "no light fitted (too few lit diffuse pixels)".into();
+    };
+    let d = l.direction().unwrap_or_default();
+    format!(
+        "light toward ({:.3}, {:.3}, {:.3}) in the camera frame, strength {:.3}, ambient {:.3} (units of the S0 scale)",
+        d.x,
+        d.y,
+        d.z,
+        l.strength(),
+        l.ambient
+    )
 }
 
 fn write(ctx: &Context<'_>, s: &Shape) -> Result<(), Failure> {
