@@ -273,8 +273,9 @@ pub enum Inversion {
     /// `L = A_inf + t (S0 - A_inf) / (t^2 + w)`. Where `t` is near `t_min` (sky, dense
     /// haze: the radiance is not recoverable) the result tends to the local airlight instead
     /// of multiplying the misfit of `A_inf` by `1 / t_min` (the gain `t / (t^2 + w)` peaks
-    /// at `t = t_min` with `1 / (t_min (2 - t_min))`, about half); haze-free pixels (`t = 1`) are returned exactly, and in between
-    /// `L - A_inf` is shrunk by the fraction `w / (t^2 + w)` (2 % at `t = 0.5`, `t_min = 0.1`).
+    /// at `t = t_min` with `1 / (t_min (2 - t_min))`, about half); haze-free pixels
+    /// (`t = 1`) are returned exactly, and in between `L - A_inf` is shrunk by the
+    /// fraction `w / (t^2 + w)`.
     Regularized,
 }
 

@@ -60,7 +60,7 @@ pub fn run(args: &StokesArgs) -> Result<(), CliError> {
     let file = resolve(&args.input, None)?;
     out_dir::check(&args.input, &args.out)?;
     let start = Instant::now();
-    let reading = read_input(&file, &args.read)?;
+    let mut reading = read_input(&file, &args.read)?;
     let obs = &reading.obs;
     reading
         .warnings
@@ -68,7 +68,7 @@ pub fn run(args: &StokesArgs) -> Result<(), CliError> {
         .for_each(|w| eprintln!("warning: {w}"));
     let mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let computed = start.elapsed();
-    let mut timings = reading.timings.clone();
+    let mut timings = std::mem::take(&mut reading.timings);
     let staged = timings.time("staging folder", || out_dir::stage(&args.out))?;
     let planes = Planes {
         planes: &obs.planes,
