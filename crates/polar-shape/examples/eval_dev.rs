@@ -6,7 +6,8 @@
 //! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]
 //! [--only TEXT] [--no-speed] [--ior N|auto]` (default `/work/data/dev`; samples `sfp-*` and
 //! the Mitsuba task scenes `mts-shape-*`; `--only` keeps names containing TEXT, `--no-speed`
-//! skips the timing of upscaled frames, `--ior` as `polar-vision run --ior`, default 1.5).
+//! skips the timing of upscaled frames, `--ior` as `polar-vision run --ior`, default 1.5,
+//! `--oracle-fg` also runs the local method on the true object mask).
 //! Each line also gives the index used and its source, and the true indices of the
 //! sample's objects from its meta.json (read here for evaluation only), and the light
 //! fitted to the shading (direction in the camera frame, strength, ambient). The Stokes planes come from the raw mosaic (residual
@@ -31,6 +32,8 @@ struct Args {
     only: Option<String>,
     speed: bool,
     ior: IorOption,
+    /// Also run the local method on the true object mask.
+    oracle_fg: bool,
 }
 
 fn args() -> Args {
@@ -41,6 +44,7 @@ fn args() -> Args {
         only: None,
         speed: true,
         ior: IorOption::Default,
+        oracle_fg: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(s) = it.next() {
@@ -49,13 +53,14 @@ fn args() -> Args {
             "--debug" => a.debug = it.next().map(PathBuf::from),
             "--only" => a.only = it.next(),
             "--no-speed" => a.speed = false,
+            "--oracle-fg" => a.oracle_fg = true,
             "--ior" => {
                 let v = it.next().unwrap_or_default();
                 a.ior = v.parse().unwrap_or_else(|e| panic!("--ior {v}: {e}"));
             }
             "--help" | "-h" => {
                 println!(
-                    "eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto]"
+                    "eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto] [--oracle-fg]"
                 );
                 std::process::exit(0);
             }
@@ -199,6 +204,13 @@ fn main() {
                 debug_pictures(d, &name, &m.to_string(), &shape, gt, &mask);
             }
         }
+        if a.oracle_fg {
+            let (mean, median) = oracle_foreground(&obs, gt, &mask);
+            line += &format!(" | local on gt mask: mean {mean:5.1} med {median:5.1}");
+            let e = acc.entry(("oracle".into(), noise.clone())).or_default();
+            e.means.push(mean);
+            e.medians.push(median);
+        }
         println!("{line}");
         if let Some(d) = &a.debug {
             cue_pictures(d, &name, &obs);
@@ -226,6 +238,29 @@ fn main() {
             e.secs / n * 1e3
         );
     }
+}
+
+/// Mean and median error of the local method given the true object mask as its
+/// foreground (index 1.5): what a perfect foreground would be worth.
+fn oracle_foreground(obs: &Observation, gt: &NormalImage, mask: &Gray<u8>) -> (f64, f64) {
+    let cues = polar_shape::cues::Cues::new(obs, polar_shape::DEFAULT_IOR).unwrap();
+    let fg: Vec<bool> = mask
+        .as_slice()
+        .iter()
+        .zip(&cues.valid)
+        .map(|(&m, &v)| m != 0 && v)
+        .collect();
+    let est = polar_shape::local::disambiguate(&cues, &fg).unwrap();
+    let (w, h) = mask.size();
+    let data = est
+        .normals
+        .iter()
+        .flat_map(|n| [n.x as f32, n.y as f32, n.z as f32])
+        .collect();
+    let normals: NormalImage = Image::from_vec(w, h, data).unwrap();
+    angular_error(&normals, gt, Some(mask))
+        .unwrap()
+        .map_or((f64::NAN, f64::NAN), |s| (s.mean, s.median))
 }
 
 /// The estimate with `(0, 0, 1)` (facing the camera) where it has no normal, so a
