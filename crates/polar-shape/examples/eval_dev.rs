@@ -205,11 +205,17 @@ fn main() {
             }
         }
         if a.oracle_fg {
-            let (mean, median) = oracle_foreground(&obs, gt, &mask);
-            line += &format!(" | local on gt mask: mean {mean:5.1} med {median:5.1}");
-            let e = acc.entry(("oracle".into(), noise.clone())).or_default();
-            e.means.push(mean);
-            e.medians.push(median);
+            for prior_only in [false, true] {
+                let (mean, median) = oracle_foreground(&obs, gt, &mask, prior_only);
+                line += &format!(
+                    " | gt mask (prior only {prior_only}): mean {mean:5.1} med {median:5.1}"
+                );
+                let e = acc
+                    .entry((format!("oracle{}", u8::from(prior_only)), noise.clone()))
+                    .or_default();
+                e.means.push(mean);
+                e.medians.push(median);
+            }
         }
         println!("{line}");
         if let Some(d) = &a.debug {
@@ -242,15 +248,26 @@ fn main() {
 
 /// Mean and median error of the local method given the true object mask as its
 /// foreground (index 1.5): what a perfect foreground would be worth.
-fn oracle_foreground(obs: &Observation, gt: &NormalImage, mask: &Gray<u8>) -> (f64, f64) {
+fn oracle_foreground(
+    obs: &Observation,
+    gt: &NormalImage,
+    mask: &Gray<u8>,
+    prior_only: bool,
+) -> (f64, f64) {
     let cues = polar_shape::cues::Cues::new(obs, polar_shape::DEFAULT_IOR).unwrap();
-    let fg: Vec<bool> = mask
+    let true_fg: Vec<bool> = mask
         .as_slice()
         .iter()
         .zip(&cues.valid)
         .map(|(&m, &v)| m != 0 && v)
         .collect();
-    let est = polar_shape::local::disambiguate(&cues, &fg).unwrap();
+    let prior = polar_shape::local::boundary_prior(&cues, &true_fg).unwrap();
+    let fg = if prior_only {
+        polar_shape::foreground::foreground(&cues).unwrap()
+    } else {
+        true_fg
+    };
+    let est = polar_shape::local::disambiguate_with(&cues, &fg, &prior).unwrap();
     let (w, h) = mask.size();
     let data = est
         .normals

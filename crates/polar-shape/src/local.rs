@@ -7,6 +7,10 @@
 //!    smoothly toward the viewer inside. With `D` the distance to the nearest background
 //!    pixel and `R` its maximum over the object's connected component, the prior normal
 //!    has azimuth `−∇D` (smoothed) and zenith `asin(1 − D/R)` (exact for a sphere).
+//!    It starts the iterations everywhere but weighs in them only where the nearest
+//!    boundary shows the occluding-contour signature in its polarization
+//!    ([`verified_contour`]), so a cast shadow or a missed part of an object does not
+//!    pull the normals toward a boundary that is not a silhouette.
 //! 2. Candidates per pixel, in the per-pixel Stokes frame: diffuse azimuths `AoLP`,
 //!    `AoLP + π` and specular ones `AoLP ± π/2`. Observed light mixes diffuse, specular
 //!    and unpolarized parts, so DoLP only bounds the zenith (`DoLP ≤ ρ(θ)` of the
@@ -30,11 +34,12 @@
 
 use nalgebra::Vector3;
 use polar_image::Gray;
-use polar_imgproc::{Connectivity, gaussian_blur, label};
+use polar_imgproc::{Border, Connectivity, gaussian_blur, gaussian_kernel, label, sep_filter};
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use crate::cues::{Cues, image_direction_angle};
+use crate::foreground::has_contour;
 use crate::{Estimate, ReflectionType, ShapeError};
 
 /// Cost of explaining a pixel without specular evidence by the specular model.
@@ -45,6 +50,14 @@ const FIELD_SIGMA: f64 = 1.5;
 const PRIOR_WEIGHT: f64 = 0.5;
 /// Iterations of candidate choice and field update.
 const ITERATIONS: usize = 6;
+/// Depth (pixels from the background) of the boundary band whose polarization
+/// [`verified_contour`] tests.
+const CONTOUR_BAND: f64 = 2.0;
+/// Gaussian sigma (pixels) along the boundary of that test.
+const CONTOUR_SIGMA: f64 = 2.0;
+/// How much farther (pixels) than the nearest boundary a verified contour may be for a
+/// pixel to keep its prior.
+const VERIFIED_SLACK: f64 = 1.0;
 
 /// The prior of step 1: a unit normal and a weight per pixel.
 pub struct Prior {
@@ -56,8 +69,12 @@ pub struct Prior {
 
 /// Disambiguated normals of the foreground pixels.
 pub fn disambiguate(cues: &Cues, fg: &[bool]) -> Result<Estimate, ShapeError> {
+    disambiguate_with(cues, fg, &boundary_prior(cues, fg)?)
+}
+
+/// [`disambiguate`] with a given prior.
+pub fn disambiguate_with(cues: &Cues, fg: &[bool], prior: &Prior) -> Result<Estimate, ShapeError> {
     let n = cues.len();
-    let prior = boundary_prior(cues, fg)?;
     let mut field = prior.normal.clone();
     let mut chosen: Vec<(Vector3<f64>, ReflectionType, f64)> = Vec::new();
     for _ in 0..ITERATIONS {
@@ -71,7 +88,7 @@ pub fn disambiguate(cues: &Cues, fg: &[bool]) -> Result<Estimate, ShapeError> {
                 }
             })
             .collect();
-        field = smooth_field(cues, fg, &chosen, &prior)?;
+        field = smooth_field(cues, fg, &chosen, prior)?;
     }
     let out: Vec<(Vector3<f64>, f32)> = (0..n)
         .into_par_iter()
@@ -192,7 +209,10 @@ fn blur(src: &Gray<f32>) -> Result<Gray<f32>, ShapeError> {
     Ok(dst)
 }
 
-/// The occluding-boundary prior of step 1 (module doc).
+/// The occluding-boundary prior of step 1 (module doc). It starts the iterations
+/// everywhere, but weighs in them only where the nearest boundary is a verified
+/// occluding contour ([`verified_contour`]), or everywhere when no part of the boundary
+/// is.
 pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let n = w * h;
@@ -207,6 +227,13 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
     }
     let radius = component_max(fg, &dist, w, h)?;
     let outward = outward_directions(&dist, w, h)?;
+    let seeds = verified_contour(cues, fg, &dist, &outward)?;
+    let to_verified = if seeds.iter().any(|&s| s) {
+        let not_seed: Vec<bool> = seeds.iter().map(|&s| !s).collect();
+        distance_to_background(&not_seed, w, h)
+    } else {
+        dist.clone()
+    };
     let out: Vec<(Vector3<f64>, f64)> = (0..n)
         .into_par_iter()
         .map(|k| {
@@ -221,13 +248,77 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
                 return (-f.d, 0.0);
             }
             let az = image_direction_angle(&f, dx, dy);
-            (f.normal(az, sin_z.asin()), sin_z * sin_z)
+            // Unverified: the prior still starts the iterations, without weight in them.
+            let verified = to_verified[k] <= dist[k] + VERIFIED_SLACK;
+            (
+                f.normal(az, sin_z.asin()),
+                f64::from(u8::from(verified)) * sin_z * sin_z,
+            )
         })
         .collect();
     Ok(Prior {
         normal: out.iter().map(|v| v.0).collect(),
         weight: out.iter().map(|v| v.1).collect(),
     })
+}
+
+/// Background pixels next to the part of the foreground's boundary that shows the
+/// occluding-contour signature: within [`CONTOUR_BAND`] pixels of the background, the
+/// AoLP parallel (diffuse) or perpendicular (specular) to the boundary's normal, i.e.
+/// the local DoLP-weighted sum of `cos 4Δ` significant against random angles
+/// ([`has_contour`] over a Gaussian window of [`CONTOUR_SIGMA`] along the boundary).
+/// A cast shadow taken into the foreground, or a cut through an object whose rest it
+/// missed, has no such signature and so does not steer the prior.
+fn verified_contour(
+    cues: &Cues,
+    fg: &[bool],
+    dist: &[f64],
+    outward: &[(f64, f64)],
+) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let in_band = |k: usize| fg[k] && cues.valid[k] && dist[k] <= CONTOUR_BAND;
+    let mut sums = [
+        vec![0.0f32; w * h],
+        vec![0.0f32; w * h],
+        vec![0.0f32; w * h],
+    ];
+    for k in (0..w * h).filter(|&k| in_band(k)) {
+        let (dx, dy) = outward[k];
+        if dx.hypot(dy) < 1e-6 {
+            continue;
+        }
+        let normal = image_direction_angle(&cues.frame(k), dx, dy);
+        let rho = f64::from(cues.dolp[k]);
+        sums[0][k] = (rho * (4.0 * (f64::from(cues.aolp[k]) - normal)).cos()) as f32;
+        sums[1][k] = rho as f32;
+        sums[2][k] = (rho * rho) as f32;
+    }
+    let g = gaussian_kernel((CONTOUR_SIGMA * 6.0).round() as usize | 1, CONTOUR_SIGMA)?;
+    let g2: Vec<f32> = g.iter().map(|v| v * v).collect();
+    let filter = |src: Vec<f32>, kernel: &[f32]| -> Result<Vec<f32>, ShapeError> {
+        let src = Gray::from_vec(w, h, src).expect("sized");
+        let mut dst = Gray::new(w, h);
+        sep_filter(&src, &mut dst, kernel, kernel, Border::Reflect101)?;
+        Ok(dst.into_vec())
+    };
+    let [c, r, r2] = sums;
+    let (c, r, r2) = (filter(c, &g)?, filter(r, &g)?, filter(r2, &g2)?);
+    let verified: Vec<bool> = (0..w * h)
+        .map(|k| in_band(k) && has_contour(f64::from(c[k]), f64::from(r[k]), f64::from(r2[k])))
+        .collect();
+    Ok((0..w * h)
+        .map(|k| !fg[k] && neighbours8(k, w, h).any(|j| verified[j]))
+        .collect())
+}
+
+/// The 8-neighbours of pixel `k` inside a `w × h` image.
+fn neighbours8(k: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
+    let (x, y) = ((k % w) as isize, (k / w) as isize);
+    let (w, h) = (w as isize, h as isize);
+    (-1isize..=1)
+        .flat_map(move |dy| (-1isize..=1).map(move |dx| (x + dx, y + dy)))
+        .filter(move |&(a, b)| (a, b) != (x, y) && (0..w).contains(&a) && (0..h).contains(&b))
+        .map(move |(a, b)| (b * w + a) as usize)
 }
 
 /// Outward directions `(−∂D/∂x, −∂D/∂y)` (image axes, y down, not normalised) of the

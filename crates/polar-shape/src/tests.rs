@@ -569,6 +569,54 @@ fn contour_signature_test() {
     assert!(!has_contour(0.0, 0.0, 0.0));
 }
 
+/// A cast shadow merged into the foreground (an unpolarized rectangle attached to the
+/// sphere's right side) has no occluding-contour signature, so the boundary prior gives
+/// no weight to the pixels whose nearest boundary is the shadow's; the sphere's own
+/// contour elsewhere keeps its prior.
+#[test]
+fn merged_cast_shadow_does_not_steer_the_prior() {
+    let scene = sphere_scene(96, 1.5);
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let truth: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    let shadow = |k: usize| (70..92).contains(&(k % 96)) && (36..60).contains(&(k / 96));
+    let fg: Vec<bool> = (0..truth.len()).map(|k| truth[k] || shadow(k)).collect();
+    let prior = crate::local::boundary_prior(&cues, &fg).unwrap();
+    let sphere_only = crate::local::boundary_prior(&cues, &truth).unwrap();
+    // Shadow pixels more than 6 pixels (three window sigmas along the boundary) from
+    // the sphere: their nearest boundary is the shadow's own.
+    let off_sphere: Vec<bool> = truth.iter().map(|t| !t).collect();
+    let from_sphere = crate::local::distance_to_background(&off_sphere, 96, 96);
+    let steered: Vec<usize> = (0..fg.len())
+        .filter(|&k| shadow(k) && from_sphere[k] > 6.0 && prior.weight[k] > 0.0)
+        .collect();
+    assert!(
+        steered.is_empty(),
+        "shadow pixels steer the prior: {steered:?}"
+    );
+    // The sphere's left half is far from the shadow: its prior is the sphere-only one
+    // (its nearest boundary is the sphere's verified contour, 0.5 weight at most lost
+    // to the different component radius).
+    let left: Vec<usize> = (0..fg.len()).filter(|&k| truth[k] && k % 96 < 40).collect();
+    assert!(!left.is_empty());
+    for &k in &left {
+        assert!(
+            prior.weight[k] > 0.5 * sphere_only.weight[k] - 1e-12,
+            "pixel {k}: {} against {}",
+            prior.weight[k],
+            sphere_only.weight[k]
+        );
+    }
+    let rim = left
+        .iter()
+        .filter(|&&k| sphere_only.weight[k] > 0.5)
+        .count();
+    assert!(rim > 20, "too few weighted rim pixels: {rim}");
+}
+
 /// The shape of `obs` with the index estimated (local method).
 fn estimated(obs: &Observation) -> Shape {
     let o = ShapeOptions {
