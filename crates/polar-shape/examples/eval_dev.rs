@@ -339,6 +339,17 @@ fn debug_pictures(
         }
     }
     polar_io::write_rgb8_png(dir.join(format!("{name}_{m}.png")), &upscale(&rgb, 3)).unwrap();
+    // Foreground against the object mask: white both, red foreground only, blue object only.
+    let mut fgt = Image::<u8, 3>::new(w, h);
+    for (k, p) in fgt.pixels_mut().iter_mut().enumerate() {
+        *p = match (shape.foreground.as_slice()[k] != 0, mask.as_slice()[k] != 0) {
+            (true, true) => [255, 255, 255],
+            (true, false) => [255, 0, 0],
+            (false, true) => [0, 0, 255],
+            (false, false) => [0, 0, 0],
+        };
+    }
+    polar_io::write_rgb8_png(dir.join(format!("{name}_{m}_fg.png")), &fgt).unwrap();
 }
 
 fn cue_pictures(dir: &Path, name: &str, obs: &Observation) {

@@ -17,7 +17,7 @@
 //!    highlights inside an object) is the foreground, eroded by 3×3 (undoing the
 //!    dilation) and opened by 3×3 to drop thin edge lines.
 //!
-//! **B. Coherently polarized regions with an occluding contour** (for silhouettes too weak
+//! **B. Coherently polarized regions** (for silhouettes too weak
 //! to be enclosed by A, e.g. a bright object on a bright floor):
 //! 1. the Rayleigh statistic of the AoLP in a Gaussian window, `z = |Σ g e^{2iα}|² / Σ g²`
 //!    (Mardia & Jupp, *Directional Statistics*, §6.3.1, on the doubled angle): about 1 where
@@ -29,10 +29,17 @@
 //!    at grazing, so around a hole seen through an object (a torus) the DoLP is highest
 //!    next to the hole, while around a patch facing the camera (low DoLP) it rises away
 //!    from it ([`fill_object_holes`]);
-//! 3. a region is kept only if its boundary shows the occluding-contour signature: the
-//!    AoLP parallel (diffuse) or perpendicular (specular) to the boundary's 2-D normal,
-//!    i.e. the DoLP-weighted mean of `cos 4Δ` (Δ = AoLP − normal direction) more than
-//!    three standard deviations above 0, its value for a random AoLP ([`has_contour`]).
+//! 3. a hole is also left open when its median log brightness is closer to the
+//!    background's around the regions than to the region's around it
+//!    ([`looks_through`]): background seen through the object.
+//!
+//! **The union**: B's regions, and A's outside the holes B left open. A's edge-free
+//! interiors that B does not touch and that the rest of the foreground encloses are
+//! opened by the same brightness test ([`open_see_through_holes`]): edges also enclose
+//! the hole of a torus. (The occluding-contour signature, the AoLP parallel or
+//! perpendicular to the boundary's normal, [`has_contour`], is not a filter here: on
+//! glossy objects the diffuse and specular parts cancel along stretches of the rim, and
+//! the shape prior uses it per boundary pixel instead, `crate::local`.)
 //!
 //! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
 //! the view, a tiny image), every valid pixel is foreground: the frame shows one surface
@@ -41,6 +48,7 @@
 //! broken up to form a coherent field at the window's scale.
 
 use std::collections::VecDeque;
+use std::ops::RangeInclusive;
 
 use polar_image::Gray;
 use polar_imgproc::mask::{components, fill_holes, remove_small};
@@ -50,7 +58,7 @@ use polar_imgproc::{
 };
 
 use crate::ShapeError;
-use crate::cues::{Cues, image_direction_angle};
+use crate::cues::Cues;
 
 /// Weight of a polarization step against a log-brightness step.
 const POLARIZATION_WEIGHT: f32 = 4.0;
@@ -65,16 +73,18 @@ const DARK_FLOOR: f32 = 0.02;
 /// Gaussian window sigma (pixels) of the Rayleigh statistic: wider than the few pixels
 /// over which demosaicing correlates the AoLP of noise, narrower than small objects.
 const COHERENCE_SIGMA: f64 = 3.0;
-/// Sigma (pixels) of the smoothed region mask whose gradient gives the boundary normal.
-const BOUNDARY_SIGMA: f64 = 1.5;
-/// Smoothed-mask gradient (per pixel) above which a region pixel is on its boundary.
-const BOUNDARY_GRADIENT: f64 = 0.05;
 /// Significance (standard deviations) of the occluding-contour signature.
 const CONTOUR_SIGNIFICANCE: f64 = 3.0;
 /// Distances (4-connected steps) from a hole of the near ring (`< RING_NEAR`) and of the
 /// far ring (`RING_NEAR..RING_FAR`) whose DoLP [`fill_object_holes`] compares.
 const RING_NEAR: u32 = 2;
 const RING_FAR: u32 = 6;
+/// Width (4-connected steps) of the dilated edges between an edge-free interior and
+/// the object around it.
+const EDGE_BAND: u32 = 4;
+/// Fraction of the ring around an interior region that must be foreground for the
+/// region to be a hole.
+const HOLE_ENCLOSURE: f64 = 0.9;
 
 /// Foreground mask (`true` on objects) of the cues (module doc).
 pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
@@ -87,10 +97,14 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         return Ok(cues.valid.clone());
     }
     let enclosed = enclosed_by_edges(cues)?;
-    let coherent = coherent_regions(cues)?;
+    let coherent = coherent_with_holes(cues)?;
     let fg: Vec<bool> = (0..w * h)
-        .map(|k| cues.valid[k] && (enclosed[k] || coherent[k]))
+        .map(|k| {
+            cues.valid[k]
+                && (coherent.regions[k] || (enclosed.regions[k] && !coherent.open_holes[k]))
+        })
         .collect();
+    let fg = open_see_through_holes(cues, fg, &enclosed, &coherent.regions)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -99,7 +113,14 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
 }
 
 /// Cue A of the module doc (at least 3×3 pixels).
-fn enclosed_by_edges(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
+/// Cue A's regions and, inside them, the edge-free regions the edges enclose (object
+/// faces, or the background seen through a hole).
+pub(crate) struct Enclosed {
+    pub(crate) regions: Vec<bool>,
+    pub(crate) interiors: Vec<bool>,
+}
+
+pub(crate) fn enclosed_by_edges(cues: &Cues) -> Result<Enclosed, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let g = edge_strength(cues)?;
     let t = (OTSU_FRACTION * threshold_otsu(&g)?).max(MIN_EDGE);
@@ -111,9 +132,71 @@ fn enclosed_by_edges(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         .collect();
     let edges = morph_mask(&edges, w, h, Morph::Dilate)?;
     let background = border_regions(&edges, w, h)?;
+    let interiors = (0..w * h).map(|k| !edges[k] && !background[k]).collect();
     let raw: Vec<bool> = background.iter().map(|&b| !b).collect();
     let raw = morph_mask(&raw, w, h, Morph::Erode)?;
-    morph_mask(&raw, w, h, Morph::Open)
+    Ok(Enclosed {
+        regions: morph_mask(&raw, w, h, Morph::Open)?,
+        interiors,
+    })
+}
+
+/// `fg` without the edge-free interiors (not touching cue B) that are holes of the rest
+/// of `fg` and look like the background seen through them (see [`looks_through`]).
+pub(crate) fn open_see_through_holes(
+    cues: &Cues,
+    fg: Vec<bool>,
+    enclosed: &Enclosed,
+    coherent: &[bool],
+) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let (id, n) = components(&enclosed.interiors, w, h)?;
+    let mut touches_b = vec![false; n + 1];
+    for k in (0..w * h).filter(|&k| coherent[k]) {
+        touches_b[id[k] as usize] = true;
+    }
+    let outside = median(
+        ring(&fg, w, h, 1..=RING_FAR)
+            .into_iter()
+            .filter(|&k| cues.valid[k])
+            .map(|k| log_brightness(cues, k))
+            .collect(),
+    );
+    let mut out = fg.clone();
+    for c in (1..=n as u32).filter(|&c| !touches_b[c as usize]) {
+        let part: Vec<bool> = id.iter().map(|&i| i == c).collect();
+        let around = ring(&part, w, h, 1..=RING_FAR);
+        let enclosed_by_fg = around.iter().filter(|&&k| fg[k]).count();
+        if (enclosed_by_fg as f64) < HOLE_ENCLOSURE * around.len() as f64 {
+            continue;
+        }
+        let brightness = |ks: &mut dyn Iterator<Item = usize>| {
+            median(
+                ks.filter(|&k| cues.valid[k])
+                    .map(|k| log_brightness(cues, k))
+                    .collect(),
+            )
+        };
+        let hole = brightness(&mut (0..w * h).filter(|&k| part[k]));
+        // Beyond the edge band that separates the interior from the object.
+        let beyond = ring(&part, w, h, EDGE_BAND + 1..=EDGE_BAND + RING_FAR);
+        let object = brightness(&mut beyond.into_iter().filter(|&k| fg[k]));
+        if looks_through(hole, object, outside) {
+            for (o, &p) in out.iter_mut().zip(&part) {
+                *o &= !p;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A hole whose median log brightness is closer to the background's around the objects
+/// than to the object's around it shows the background through the object (a torus).
+fn looks_through(hole: Option<f32>, object: Option<f32>, background: Option<f32>) -> bool {
+    match (hole, object, background) {
+        (Some(hole), Some(object), Some(bg)) => (hole - bg).abs() < (hole - object).abs(),
+        _ => false,
+    }
 }
 
 /// The edge strength `g` of the module doc.
@@ -176,7 +259,19 @@ fn morph_mask(mask: &[bool], w: usize, h: usize, op: Morph) -> Result<Vec<bool>,
 }
 
 /// Cue B of the module doc (at least 3×3 pixels).
+#[cfg(test)]
 pub(crate) fn coherent_regions(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
+    Ok(coherent_with_holes(cues)?.regions)
+}
+
+/// Cue B's regions and the holes in them that it left open (a torus's hole).
+struct Coherent {
+    regions: Vec<bool>,
+    open_holes: Vec<bool>,
+}
+
+/// Cue B of the module doc, with the holes it leaves open.
+fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let z = rayleigh_statistic(cues)?;
     let t = threshold_otsu(&z)?;
@@ -185,7 +280,13 @@ pub(crate) fn coherent_regions(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     let window = std::f64::consts::PI * (2.0 * COHERENCE_SIGMA).powi(2);
     let regions = remove_small(&opened, w, h, window as usize)?;
     let filled = fill_object_holes(cues, &regions)?;
-    with_contour(cues, &filled)
+    let regions = filled;
+    let all_holes = fill_holes(&regions, w, h)?;
+    let open_holes = (0..w * h).map(|k| all_holes[k] && !regions[k]).collect();
+    Ok(Coherent {
+        regions,
+        open_holes,
+    })
 }
 
 /// Rayleigh statistic `z = |Σ g e^{2iα}|² / Σ g²` of the AoLP over a Gaussian window `g`
@@ -243,6 +344,12 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
     let mut queue: VecDeque<usize> = (0..w * h).filter(|&k| holes[k]).collect();
     // Per hole: [near DoLP sum, near count, far DoLP sum, far count].
     let mut rings = vec![[0.0f64; 4]; n + 1];
+    // Per hole: log brightness of the hole and of the region around it.
+    let mut inside: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    let mut around: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    for k in (0..w * h).filter(|&k| holes[k] && cues.valid[k]) {
+        inside[hole_id[k] as usize].push(log_brightness(cues, k));
+    }
     while let Some(k) = queue.pop_front() {
         if dist[k] >= RING_FAR {
             continue;
@@ -262,6 +369,7 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
             owner[j] = owner[k];
             queue.push_back(j);
             if cues.valid[j] {
+                around[owner[j] as usize].push(log_brightness(cues, j));
                 let slot = if dist[k] < RING_NEAR { 0 } else { 2 };
                 let r = &mut rings[owner[j] as usize];
                 r[slot] += f64::from(cues.dolp[j]);
@@ -269,49 +377,70 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
             }
         }
     }
-    let open_hole: Vec<bool> = rings
-        .iter()
-        .map(|r| r[1] > 0.0 && r[3] > 0.0 && r[0] / r[1] > r[2] / r[3])
+    let outside = ring(&filled, w, h, 1..=RING_FAR)
+        .into_iter()
+        .filter(|&k| cues.valid[k])
+        .map(|k| log_brightness(cues, k))
+        .collect::<Vec<_>>();
+    let outside = median(outside);
+    let open_hole: Vec<bool> = (0..=n)
+        .map(|i| {
+            let r = rings[i];
+            let contour = r[1] > 0.0 && r[3] > 0.0 && r[0] / r[1] > r[2] / r[3];
+            contour
+                || looks_through(
+                    median(std::mem::take(&mut inside[i])),
+                    median(std::mem::take(&mut around[i])),
+                    outside,
+                )
+        })
         .collect();
     Ok((0..w * h)
         .map(|k| m[k] || (holes[k] && !open_hole[hole_id[k] as usize]))
         .collect())
 }
 
-/// The 8-connected components of `m` that pass [`has_contour`].
-fn with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
-    let (w, h) = (cues.width, cues.height);
-    let (id, n) = components(m, w, h)?;
-    if n == 0 {
-        return Ok(m.to_vec());
+/// `ln(S0 + floor)` of pixel `k` (normalised S0, [`DARK_FLOOR`]).
+fn log_brightness(cues: &Cues, k: usize) -> f32 {
+    (cues.s0n[k].max(0.0) + DARK_FLOOR).ln()
+}
+
+/// The median of `v`, `None` if empty.
+fn median(mut v: Vec<f32>) -> Option<f32> {
+    if v.is_empty() {
+        return None;
     }
-    let mask =
-        Gray::from_vec(w, h, m.iter().map(|&b| f32::from(u8::from(b))).collect()).expect("sized");
-    let mut smooth = Gray::new(w, h);
-    gaussian_blur(&mask, &mut smooth, 0, BOUNDARY_SIGMA)?;
-    let (mut gx, mut gy) = (Gray::new(w, h), Gray::new(w, h));
-    sobel(&smooth, &mut gx, 1, 0, 3)?;
-    sobel(&smooth, &mut gy, 0, 1, 3)?;
-    // Per component: Σ ρ cos 4Δ, Σ ρ, Σ ρ².
-    let mut sums = vec![[0.0f64; 3]; n + 1];
-    for k in 0..w * h {
-        if !m[k] || !cues.valid[k] {
+    let mid = v.len() / 2;
+    Some(*v.select_nth_unstable_by(mid, f32::total_cmp).1)
+}
+
+/// The pixels outside `m` at a number of 4-connected steps from it in `steps`.
+fn ring(m: &[bool], w: usize, h: usize, steps: RangeInclusive<u32>) -> Vec<usize> {
+    let mut dist: Vec<u32> = m.iter().map(|&o| if o { 0 } else { u32::MAX }).collect();
+    let mut queue: VecDeque<usize> = (0..w * h).filter(|&k| m[k]).collect();
+    let mut ring = Vec::new();
+    while let Some(k) = queue.pop_front() {
+        if dist[k] >= *steps.end() {
             continue;
         }
-        // Outward normal = −∇(smoothed mask); a unit ramp gives a Sobel response of 8.
-        let (dx, dy) = (-f64::from(gx.as_slice()[k]), -f64::from(gy.as_slice()[k]));
-        if dx.hypot(dy) / 8.0 < BOUNDARY_GRADIENT {
-            continue;
+        let (x, y) = (k % w, k / w);
+        let neighbours = [
+            (x > 0).then(|| k - 1),
+            (x + 1 < w).then(|| k + 1),
+            (y > 0).then(|| k - w),
+            (y + 1 < h).then(|| k + w),
+        ];
+        for j in neighbours.into_iter().flatten() {
+            if dist[j] == u32::MAX {
+                dist[j] = dist[k] + 1;
+                if steps.contains(&dist[j]) {
+                    ring.push(j);
+                }
+                queue.push_back(j);
+            }
         }
-        let normal = image_direction_angle(&cues.frame(k), dx, dy);
-        let rho = f64::from(cues.dolp[k]);
-        let s = &mut sums[id[k] as usize];
-        s[0] += rho * (4.0 * (f64::from(cues.aolp[k]) - normal)).cos();
-        s[1] += rho;
-        s[2] += rho * rho;
     }
-    let keep: Vec<bool> = sums.iter().map(|s| has_contour(s[0], s[1], s[2])).collect();
-    Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
+    ring
 }
 
 /// The occluding-contour test of a boundary from `Σ ρ cos 4Δ`, `Σ ρ` and `Σ ρ²` over its

@@ -502,9 +502,9 @@ fn textured_floor_and_cast_shadow_are_not_coherent_foreground() {
 /// An annulus with the normal field of a torus facing the camera (tube radius `r`
 /// around a circle of radius `big_r`, both in units of the image-plane slope `d.xy/−d.z`),
 /// diffuse, on a noisy unpolarized background.
-fn torus_scene(big_r: f64, r: f64) -> Scene {
+fn torus_scene(big_r: f64, r: f64, background: f64) -> Scene {
     let l = light();
-    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.3, |d| {
+    let mut scene = Scene::render(96, 96, 30.0, 1.5, background, |d| {
         let (u, v) = (d.x / -d.z, d.y / -d.z);
         let rho = u.hypot(v);
         let t = (rho - big_r) / r;
@@ -519,7 +519,7 @@ fn torus_scene(big_r: f64, r: f64) -> Scene {
 
 #[test]
 fn torus_hole_stays_background() {
-    let scene = torus_scene(0.14, 0.07);
+    let scene = torus_scene(0.14, 0.07, 0.3);
     let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
     let fg = crate::foreground::coherent_regions(&cues).unwrap();
     let truth: Vec<bool> = scene
@@ -539,6 +539,37 @@ fn torus_hole_stays_background() {
     assert_eq!(hole, 0, "pixels of the torus hole taken as foreground");
     let iou = mask_iou(&fg, &truth);
     assert!(iou > 0.7, "torus IoU {iou}");
+}
+
+/// A foreground that took in the hole of a torus (cue A: edges enclose it; cue B fills
+/// it when the DoLP around it does not peak at the hole) gets it back as background: the
+/// hole is as bright as the background around the torus, not as the torus around it.
+/// The torus itself is kept.
+#[test]
+fn torus_hole_seen_through_stays_background() {
+    use crate::foreground::{enclosed_by_edges, open_see_through_holes};
+    // A dark floor (0.05 against the torus's 0.2-1.0), so edges close the hole off.
+    let scene = torus_scene(0.14, 0.07, 0.05);
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let truth: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    let filled = polar_imgproc::mask::fill_holes(&truth, 96, 96).unwrap();
+    let enclosed = enclosed_by_edges(&cues).unwrap();
+    let fg = open_see_through_holes(&cues, filled, &enclosed, &[false; 96 * 96]).unwrap();
+    let torus_kept = (0..fg.len()).filter(|&k| truth[k] && fg[k]).count();
+    let torus = truth.iter().filter(|&&t| t).count();
+    assert_eq!(torus_kept, torus, "torus pixels dropped");
+    let hole = (0..fg.len())
+        .filter(|&k| {
+            let (dx, dy) = ((k % 96) as f64 - 47.5, (k / 96) as f64 - 47.5);
+            dx.hypot(dy) < 8.0
+        })
+        .filter(|&k| fg[k])
+        .count();
+    assert_eq!(hole, 0, "pixels of the torus hole taken as foreground");
 }
 
 #[test]
