@@ -45,7 +45,7 @@ use crate::{Estimate, ReflectionType, ShapeError};
 /// Cost of explaining a pixel without specular evidence by the specular model.
 pub const MIXED_PENALTY: f64 = 0.05;
 /// Gaussian sigma (pixels) of the smoothness field.
-const FIELD_SIGMA: f64 = 1.5;
+const FIELD_SIGMA: f64 = 2.0;
 /// Weight of the boundary prior in the field.
 const PRIOR_WEIGHT: f64 = 0.5;
 /// Iterations of candidate choice and field update.
