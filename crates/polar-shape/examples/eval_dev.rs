@@ -206,9 +206,10 @@ fn main() {
         }
         if a.oracle_fg {
             for prior_only in [false, true] {
-                let (mean, median) = oracle_foreground(&obs, gt, &mask, prior_only);
+                let (mean, median, normals) = oracle_foreground(&obs, gt, &mask, prior_only);
+                let (ez, ea) = split_error(&normals, gt, &mask, fov);
                 line += &format!(
-                    " | gt mask (prior only {prior_only}): mean {mean:5.1} med {median:5.1}"
+                    " | gt mask (prior only {prior_only}): mean {mean:5.1} med {median:5.1} zen {ez:4.1} az {ea:4.1}"
                 );
                 let e = acc
                     .entry((format!("oracle{}", u8::from(prior_only)), noise.clone()))
@@ -246,14 +247,14 @@ fn main() {
     }
 }
 
-/// Mean and median error of the local method given the true object mask as its
+/// Mean and median error and the normals of the local method given the true object mask as its
 /// foreground (index 1.5): what a perfect foreground would be worth.
 fn oracle_foreground(
     obs: &Observation,
     gt: &NormalImage,
     mask: &Gray<u8>,
     prior_only: bool,
-) -> (f64, f64) {
+) -> (f64, f64, NormalImage) {
     let cues = polar_shape::cues::Cues::new(obs, polar_shape::DEFAULT_IOR).unwrap();
     let true_fg: Vec<bool> = mask
         .as_slice()
@@ -275,9 +276,10 @@ fn oracle_foreground(
         .flat_map(|n| [n.x as f32, n.y as f32, n.z as f32])
         .collect();
     let normals: NormalImage = Image::from_vec(w, h, data).unwrap();
-    angular_error(&normals, gt, Some(mask))
+    let (mean, median) = angular_error(&normals, gt, Some(mask))
         .unwrap()
-        .map_or((f64::NAN, f64::NAN), |s| (s.mean, s.median))
+        .map_or((f64::NAN, f64::NAN), |s| (s.mean, s.median));
+    (mean, median, normals)
 }
 
 /// The estimate with `(0, 0, 1)` (facing the camera) where it has no normal, so a

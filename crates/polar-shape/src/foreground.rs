@@ -36,7 +36,8 @@
 //! **The union**: B's regions, and A's outside the holes B left open. A's edge-free
 //! interiors that B does not touch and that the rest of the foreground encloses are
 //! opened by the same brightness test ([`open_see_through_holes`]): edges also enclose
-//! the hole of a torus. (The occluding-contour signature, the AoLP parallel or
+//! the hole of a torus. Components without any pixel of B are dropped (floor texture
+//! enclosed by edges; every object polarizes somewhere). (The occluding-contour signature, the AoLP parallel or
 //! perpendicular to the boundary's normal, [`has_contour`], is not a filter here: on
 //! glossy objects the diffuse and specular parts cancel along stretches of the rim, and
 //! the shape prior uses it per boundary pixel instead, `crate::local`.)
@@ -105,6 +106,7 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         })
         .collect();
     let fg = open_see_through_holes(cues, fg, &enclosed, &coherent.regions)?;
+    let fg = with_coherent_part(fg, &coherent.regions, w, h)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -188,6 +190,26 @@ pub(crate) fn open_see_through_holes(
         }
     }
     Ok(out)
+}
+
+/// The 8-connected components of `fg` that hold a pixel of cue B (`coherent`), or all
+/// of `fg` when B found nothing: every object polarizes somewhere, so an enclosed region
+/// without any coherent polarization is floor texture or a speck.
+fn with_coherent_part(
+    fg: Vec<bool>,
+    coherent: &[bool],
+    w: usize,
+    h: usize,
+) -> Result<Vec<bool>, ShapeError> {
+    if !coherent.iter().any(|&v| v) {
+        return Ok(fg);
+    }
+    let (id, n) = components(&fg, w, h)?;
+    let mut has_b = vec![false; n + 1];
+    for k in (0..w * h).filter(|&k| coherent[k]) {
+        has_b[id[k] as usize] = true;
+    }
+    Ok((0..w * h).map(|k| fg[k] && has_b[id[k] as usize]).collect())
 }
 
 /// A hole whose median log brightness is closer to the background's around the objects

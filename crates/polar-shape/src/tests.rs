@@ -499,6 +499,45 @@ fn textured_floor_and_cast_shadow_are_not_coherent_foreground() {
     assert_eq!(far_floor, 0, "floor texture taken as foreground");
 }
 
+/// Edges enclose two dark unpolarized patches on the floor, away from the sphere, but
+/// no coherent polarization lies in them, so the union leaves them out; the sphere is
+/// kept.
+#[test]
+fn enclosed_floor_texture_without_polarization_is_not_foreground() {
+    let centre = Vector3::new(-0.6, 0.0, -5.0);
+    let l = light();
+    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.5, |d| {
+        sphere_hit(d, centre, 0.6).map(|n| (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2)))
+    });
+    let patch = |k: usize| {
+        let (x, y) = (k % 96, k / 96);
+        (70..82).contains(&x) && ((10..22).contains(&y) || (70..82).contains(&y))
+    };
+    for (k, st) in scene.stokes.iter_mut().enumerate() {
+        if patch(k) {
+            st[0] *= 0.3;
+        }
+    }
+    add_polarization_noise(&mut scene, 0.02);
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let enclosed = crate::foreground::enclosed_by_edges(&cues).unwrap();
+    assert!(
+        (0..96 * 96).any(|k| patch(k) && enclosed.regions[k]),
+        "the patches should be enclosed by edges"
+    );
+    let fg = crate::foreground::foreground(&cues).unwrap();
+    let in_patches = (0..fg.len()).filter(|&k| fg[k] && patch(k)).count();
+    assert_eq!(in_patches, 0, "floor patches taken as foreground");
+    let truth: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    // As in the coherent-region tests: the sphere's silhouette to a pixel or two.
+    let iou = mask_iou(&fg, &truth);
+    assert!(iou > 0.8, "sphere IoU {iou}");
+}
+
 /// An annulus with the normal field of a torus facing the camera (tube radius `r`
 /// around a circle of radius `big_r`, both in units of the image-plane slope `d.xy/−d.z`),
 /// diffuse, on a noisy unpolarized background.
