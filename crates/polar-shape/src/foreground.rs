@@ -37,7 +37,9 @@
 //! interiors that B does not touch and that the rest of the foreground encloses are
 //! opened by the same brightness test ([`open_see_through_holes`]): edges also enclose
 //! the hole of a torus. Components without any pixel of B are dropped (floor texture
-//! enclosed by edges; every object polarizes somewhere). (The occluding-contour signature, the AoLP parallel or
+//! enclosed by edges; every object polarizes somewhere), and so are pixels farther than
+//! 8 % of the image's shorter side from B that the rest does not enclose (edges join a
+//! textured floor or a long shadow to an object). (The occluding-contour signature, the AoLP parallel or
 //! perpendicular to the boundary's normal, [`has_contour`], is not a filter here: on
 //! glossy objects the diffuse and specular parts cancel along stretches of the rim, and
 //! the shape prior uses it per boundary pixel instead, `crate::local`.)
@@ -60,6 +62,7 @@ use polar_imgproc::{
 
 use crate::ShapeError;
 use crate::cues::Cues;
+use crate::local::distance_to_background;
 
 /// Weight of a polarization step against a log-brightness step.
 const POLARIZATION_WEIGHT: f32 = 4.0;
@@ -83,6 +86,9 @@ const RING_FAR: u32 = 6;
 /// Width (4-connected steps) of the dilated edges between an edge-free interior and
 /// the object around it.
 const EDGE_BAND: u32 = 4;
+/// How far (fraction of the image's shorter side) foreground pixels may lie from the
+/// nearest coherently polarized pixel.
+const COHERENT_REACH: f64 = 0.08;
 /// Fraction of the ring around an interior region that must be foreground for the
 /// region to be a hole.
 const HOLE_ENCLOSURE: f64 = 0.9;
@@ -107,6 +113,7 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         .collect();
     let fg = open_see_through_holes(cues, fg, &enclosed, &coherent.regions)?;
     let fg = with_coherent_part(fg, &coherent.regions, w, h)?;
+    let fg = near_coherent(fg, &coherent.regions, w, h)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -210,6 +217,30 @@ fn with_coherent_part(
         has_b[id[k] as usize] = true;
     }
     Ok((0..w * h).map(|k| fg[k] && has_b[id[k] as usize]).collect())
+}
+
+/// `fg` within [`COHERENT_REACH`] × the image's shorter side of cue B, plus the pixels
+/// of `fg` this encloses (an object's unpolarized centre): edge-enclosed floor texture
+/// and shadows joined to an object by edges stop near it.
+fn near_coherent(
+    fg: Vec<bool>,
+    coherent: &[bool],
+    w: usize,
+    h: usize,
+) -> Result<Vec<bool>, ShapeError> {
+    if !coherent.iter().any(|&v| v) {
+        return Ok(fg);
+    }
+    let not_b: Vec<bool> = coherent.iter().map(|b| !b).collect();
+    let dist = distance_to_background(&not_b, w, h);
+    let reach = COHERENT_REACH * w.min(h) as f64;
+    let kept: Vec<bool> = fg
+        .iter()
+        .zip(&dist)
+        .map(|(&f, &d)| f && d <= reach)
+        .collect();
+    let enclosed = fill_holes(&kept, w, h)?;
+    Ok(enclosed.iter().zip(&fg).map(|(&e, &f)| e && f).collect())
 }
 
 /// A hole whose median log brightness is closer to the background's around the objects
