@@ -31,18 +31,21 @@
 //!    from it ([`fill_object_holes`]);
 //! 3. a hole is also left open when its median log brightness is closer to the
 //!    background's around the regions than to the region's around it
-//!    ([`looks_through`]): background seen through the object.
+//!    ([`looks_through`]): background seen through the object;
+//! 4. a region that reaches the image border (a glossy floor or wall may be coherent)
+//!    is kept only if its boundary shows the occluding-contour signature: the AoLP
+//!    parallel (diffuse) or perpendicular (specular) to the boundary's 2-D normal, i.e.
+//!    the DoLP-weighted mean of `cos 4Δ` (Δ = AoLP − normal direction) more than three
+//!    standard deviations above 0, its value for a random AoLP ([`has_contour`]).
 //!
 //! **The union**: B's regions, and A's outside the holes B left open. A's edge-free
 //! interiors that B does not touch and that the rest of the foreground encloses are
 //! opened by the same brightness test ([`open_see_through_holes`]): edges also enclose
 //! the hole of a torus. Components without any pixel of B are dropped (floor texture
-//! enclosed by edges; every object polarizes somewhere), and so are pixels farther than
-//! 8 % of the image's shorter side from B that the rest does not enclose (edges join a
-//! textured floor or a long shadow to an object). (The occluding-contour signature, the AoLP parallel or
-//! perpendicular to the boundary's normal, [`has_contour`], is not a filter here: on
-//! glossy objects the diffuse and specular parts cancel along stretches of the rim, and
-//! the shape prior uses it per boundary pixel instead, `crate::local`.)
+//! enclosed by edges; every object polarizes somewhere). Regions inside the frame are
+//! not held to the contour signature: on glossy objects the diffuse and specular parts
+//! cancel along stretches of the rim, and the shape prior checks it per boundary pixel
+//! instead (`crate::local`).
 //!
 //! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
 //! the view, a tiny image), every valid pixel is foreground: the frame shows one surface
@@ -61,8 +64,7 @@ use polar_imgproc::{
 };
 
 use crate::ShapeError;
-use crate::cues::Cues;
-use crate::local::distance_to_background;
+use crate::cues::{Cues, image_direction_angle};
 
 /// Weight of a polarization step against a log-brightness step.
 const POLARIZATION_WEIGHT: f32 = 4.0;
@@ -74,6 +76,10 @@ const MIN_EDGE: f32 = 0.1;
 const OTSU_FRACTION: f32 = 0.3;
 /// Brightness floor (normalised) inside the logarithm, so dark noise is not an edge.
 const DARK_FLOOR: f32 = 0.02;
+/// Sigma (pixels) of the smoothed region mask whose gradient gives the boundary normal.
+const BOUNDARY_SIGMA: f64 = 1.5;
+/// Smoothed-mask gradient (per pixel) above which a region pixel is on its boundary.
+const BOUNDARY_GRADIENT: f64 = 0.05;
 /// Gaussian window sigma (pixels) of the Rayleigh statistic: wider than the few pixels
 /// over which demosaicing correlates the AoLP of noise, narrower than small objects.
 const COHERENCE_SIGMA: f64 = 3.0;
@@ -86,9 +92,6 @@ const RING_FAR: u32 = 6;
 /// Width (4-connected steps) of the dilated edges between an edge-free interior and
 /// the object around it.
 const EDGE_BAND: u32 = 4;
-/// How far (fraction of the image's shorter side) foreground pixels may lie from the
-/// nearest coherently polarized pixel.
-const COHERENT_REACH: f64 = 0.08;
 /// Fraction of the ring around an interior region that must be foreground for the
 /// region to be a hole.
 const HOLE_ENCLOSURE: f64 = 0.9;
@@ -113,7 +116,6 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         .collect();
     let fg = open_see_through_holes(cues, fg, &enclosed, &coherent.regions)?;
     let fg = with_coherent_part(fg, &coherent.regions, w, h)?;
-    let fg = near_coherent(fg, &coherent.regions, w, h)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -171,31 +173,45 @@ pub(crate) fn open_see_through_holes(
             .map(|k| log_brightness(cues, k))
             .collect(),
     );
-    let mut out = fg.clone();
-    for c in (1..=n as u32).filter(|&c| !touches_b[c as usize]) {
-        let part: Vec<bool> = id.iter().map(|&i| i == c).collect();
-        let around = ring(&part, w, h, 1..=RING_FAR);
-        let enclosed_by_fg = around.iter().filter(|&&k| fg[k]).count();
-        if (enclosed_by_fg as f64) < HOLE_ENCLOSURE * around.len() as f64 {
+    let candidates: Vec<u32> = id
+        .iter()
+        .map(|&i| if touches_b[i as usize] { 0 } else { i })
+        .collect();
+    let (owner, dist) = grow_labels(&candidates, w, h, EDGE_BAND + RING_FAR, |_| true);
+    // Per interior: ring pixels, ring pixels in fg; brightness of the interior and of
+    // the object beyond the edge band around it.
+    let mut counts = vec![[0usize; 2]; n + 1];
+    let mut hole: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    let mut object: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    for k in (0..w * h).filter(|&k| dist[k] != u32::MAX) {
+        let (o, d) = (owner[k] as usize, dist[k]);
+        if (1..=RING_FAR).contains(&d) {
+            counts[o][0] += 1;
+            counts[o][1] += usize::from(fg[k]);
+        }
+        if !cues.valid[k] {
             continue;
         }
-        let brightness = |ks: &mut dyn Iterator<Item = usize>| {
-            median(
-                ks.filter(|&k| cues.valid[k])
-                    .map(|k| log_brightness(cues, k))
-                    .collect(),
-            )
-        };
-        let hole = brightness(&mut (0..w * h).filter(|&k| part[k]));
-        // Beyond the edge band that separates the interior from the object.
-        let beyond = ring(&part, w, h, EDGE_BAND + 1..=EDGE_BAND + RING_FAR);
-        let object = brightness(&mut beyond.into_iter().filter(|&k| fg[k]));
-        if looks_through(hole, object, outside) {
-            for (o, &p) in out.iter_mut().zip(&part) {
-                *o &= !p;
-            }
+        if d == 0 {
+            hole[o].push(log_brightness(cues, k));
+        } else if d > EDGE_BAND && fg[k] {
+            object[o].push(log_brightness(cues, k));
         }
     }
+    let open: Vec<bool> = (0..=n)
+        .map(|c| {
+            c > 0
+                && counts[c][1] as f64 >= HOLE_ENCLOSURE * counts[c][0] as f64
+                && looks_through(
+                    median(std::mem::take(&mut hole[c])),
+                    median(std::mem::take(&mut object[c])),
+                    outside,
+                )
+        })
+        .collect();
+    let out = (0..w * h)
+        .map(|k| fg[k] && !open[candidates[k] as usize])
+        .collect();
     Ok(out)
 }
 
@@ -217,30 +233,6 @@ fn with_coherent_part(
         has_b[id[k] as usize] = true;
     }
     Ok((0..w * h).map(|k| fg[k] && has_b[id[k] as usize]).collect())
-}
-
-/// `fg` within [`COHERENT_REACH`] × the image's shorter side of cue B, plus the pixels
-/// of `fg` this encloses (an object's unpolarized centre): edge-enclosed floor texture
-/// and shadows joined to an object by edges stop near it.
-fn near_coherent(
-    fg: Vec<bool>,
-    coherent: &[bool],
-    w: usize,
-    h: usize,
-) -> Result<Vec<bool>, ShapeError> {
-    if !coherent.iter().any(|&v| v) {
-        return Ok(fg);
-    }
-    let not_b: Vec<bool> = coherent.iter().map(|b| !b).collect();
-    let dist = distance_to_background(&not_b, w, h);
-    let reach = COHERENT_REACH * w.min(h) as f64;
-    let kept: Vec<bool> = fg
-        .iter()
-        .zip(&dist)
-        .map(|(&f, &d)| f && d <= reach)
-        .collect();
-    let enclosed = fill_holes(&kept, w, h)?;
-    Ok(enclosed.iter().zip(&fg).map(|(&e, &f)| e && f).collect())
 }
 
 /// A hole whose median log brightness is closer to the background's around the objects
@@ -333,7 +325,7 @@ fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
     let window = std::f64::consts::PI * (2.0 * COHERENCE_SIGMA).powi(2);
     let regions = remove_small(&opened, w, h, window as usize)?;
     let filled = fill_object_holes(cues, &regions)?;
-    let regions = filled;
+    let regions = inner_or_with_contour(cues, &filled)?;
     let all_holes = fill_holes(&regions, w, h)?;
     let open_holes = (0..w * h).map(|k| all_holes[k] && !regions[k]).collect();
     Ok(Coherent {
@@ -389,46 +381,22 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
     }
     // Breadth-first from all holes at once over the region: each pixel joins the ring
     // sums of the hole that reaches it first.
-    let mut owner = hole_id.clone();
-    let mut dist: Vec<u32> = holes
-        .iter()
-        .map(|&o| if o { 0 } else { u32::MAX })
-        .collect();
-    let mut queue: VecDeque<usize> = (0..w * h).filter(|&k| holes[k]).collect();
+    let (owner, dist) = grow_labels(&hole_id, w, h, RING_FAR, |j| m[j]);
     // Per hole: [near DoLP sum, near count, far DoLP sum, far count].
     let mut rings = vec![[0.0f64; 4]; n + 1];
     // Per hole: log brightness of the hole and of the region around it.
     let mut inside: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
     let mut around: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
-    for k in (0..w * h).filter(|&k| holes[k] && cues.valid[k]) {
-        inside[hole_id[k] as usize].push(log_brightness(cues, k));
-    }
-    while let Some(k) = queue.pop_front() {
-        if dist[k] >= RING_FAR {
+    for k in (0..w * h).filter(|&k| cues.valid[k] && dist[k] != u32::MAX) {
+        let o = owner[k] as usize;
+        if dist[k] == 0 {
+            inside[o].push(log_brightness(cues, k));
             continue;
         }
-        let (x, y) = (k % w, k / w);
-        let neighbours = [
-            (x > 0).then(|| k - 1),
-            (x + 1 < w).then(|| k + 1),
-            (y > 0).then(|| k - w),
-            (y + 1 < h).then(|| k + w),
-        ];
-        for j in neighbours.into_iter().flatten() {
-            if !m[j] || dist[j] != u32::MAX {
-                continue;
-            }
-            dist[j] = dist[k] + 1;
-            owner[j] = owner[k];
-            queue.push_back(j);
-            if cues.valid[j] {
-                around[owner[j] as usize].push(log_brightness(cues, j));
-                let slot = if dist[k] < RING_NEAR { 0 } else { 2 };
-                let r = &mut rings[owner[j] as usize];
-                r[slot] += f64::from(cues.dolp[j]);
-                r[slot + 1] += 1.0;
-            }
-        }
+        around[o].push(log_brightness(cues, k));
+        let slot = if dist[k] <= RING_NEAR { 0 } else { 2 };
+        rings[o][slot] += f64::from(cues.dolp[k]);
+        rings[o][slot + 1] += 1.0;
     }
     let outside = ring(&filled, w, h, 1..=RING_FAR)
         .into_iter()
@@ -469,11 +437,29 @@ fn median(mut v: Vec<f32>) -> Option<f32> {
 
 /// The pixels outside `m` at a number of 4-connected steps from it in `steps`.
 fn ring(m: &[bool], w: usize, h: usize, steps: RangeInclusive<u32>) -> Vec<usize> {
-    let mut dist: Vec<u32> = m.iter().map(|&o| if o { 0 } else { u32::MAX }).collect();
-    let mut queue: VecDeque<usize> = (0..w * h).filter(|&k| m[k]).collect();
-    let mut ring = Vec::new();
+    let id: Vec<u32> = m.iter().map(|&v| u32::from(v)).collect();
+    let (_, dist) = grow_labels(&id, w, h, *steps.end(), |_| true);
+    (0..w * h).filter(|&k| steps.contains(&dist[k])).collect()
+}
+
+/// Grows the labelled pixels (`id > 0`) breadth-first, 4-connected, through the pixels
+/// where `passable` holds, for at most `steps` steps: per pixel the label that reached
+/// it first and its number of steps (0 on the labelled pixels, `u32::MAX` unreached).
+fn grow_labels(
+    id: &[u32],
+    w: usize,
+    h: usize,
+    steps: u32,
+    passable: impl Fn(usize) -> bool,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut owner = id.to_vec();
+    let mut dist: Vec<u32> = id
+        .iter()
+        .map(|&i| if i > 0 { 0 } else { u32::MAX })
+        .collect();
+    let mut queue: VecDeque<usize> = (0..w * h).filter(|&k| id[k] > 0).collect();
     while let Some(k) = queue.pop_front() {
-        if dist[k] >= *steps.end() {
+        if dist[k] >= steps {
             continue;
         }
         let (x, y) = (k % w, k / w);
@@ -484,16 +470,54 @@ fn ring(m: &[bool], w: usize, h: usize, steps: RangeInclusive<u32>) -> Vec<usize
             (y + 1 < h).then(|| k + w),
         ];
         for j in neighbours.into_iter().flatten() {
-            if dist[j] == u32::MAX {
+            if dist[j] == u32::MAX && passable(j) {
                 dist[j] = dist[k] + 1;
-                if steps.contains(&dist[j]) {
-                    ring.push(j);
-                }
+                owner[j] = owner[k];
                 queue.push_back(j);
             }
         }
     }
-    ring
+    (owner, dist)
+}
+
+/// The 8-connected components of `m` that do not touch the image border or that pass
+/// [`has_contour`]: a coherent region reaching the border may be a glossy floor or wall,
+/// and is kept only with an occluding contour (an object the frame cuts).
+fn inner_or_with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let (id, n) = components(m, w, h)?;
+    if n == 0 {
+        return Ok(m.to_vec());
+    }
+    let mask =
+        Gray::from_vec(w, h, m.iter().map(|&b| f32::from(u8::from(b))).collect()).expect("sized");
+    let mut smooth = Gray::new(w, h);
+    gaussian_blur(&mask, &mut smooth, 0, BOUNDARY_SIGMA)?;
+    let (mut gx, mut gy) = (Gray::new(w, h), Gray::new(w, h));
+    sobel(&smooth, &mut gx, 1, 0, 3)?;
+    sobel(&smooth, &mut gy, 0, 1, 3)?;
+    // Per component: Σ ρ cos 4Δ, Σ ρ, Σ ρ².
+    let mut sums = vec![[0.0f64; 3]; n + 1];
+    let mut at_border = vec![false; n + 1];
+    for k in (0..w * h).filter(|&k| m[k]) {
+        let (x, y) = (k % w, k / w);
+        at_border[id[k] as usize] |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+        // Outward normal = −∇(smoothed mask); a unit ramp gives a Sobel response of 8.
+        let (dx, dy) = (-f64::from(gx.as_slice()[k]), -f64::from(gy.as_slice()[k]));
+        if !cues.valid[k] || dx.hypot(dy) / 8.0 < BOUNDARY_GRADIENT {
+            continue;
+        }
+        let normal = image_direction_angle(&cues.frame(k), dx, dy);
+        let rho = f64::from(cues.dolp[k]);
+        let s = &mut sums[id[k] as usize];
+        s[0] += rho * (4.0 * (f64::from(cues.aolp[k]) - normal)).cos();
+        s[1] += rho;
+        s[2] += rho * rho;
+    }
+    let keep: Vec<bool> = (0..=n)
+        .map(|c| !at_border[c] || has_contour(sums[c][0], sums[c][1], sums[c][2]))
+        .collect();
+    Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
 }
 
 /// The occluding-contour test of a boundary from `Σ ρ cos 4Δ`, `Σ ρ` and `Σ ρ²` over its
