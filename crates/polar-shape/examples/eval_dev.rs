@@ -407,7 +407,11 @@ fn split_error(est: &NormalImage, gt: &NormalImage, mask: &Gray<u8>, fov: f64) -
         let (ag, zg) = f.angles(&v(g));
         let da = (ae - ag).rem_euclid(std::f64::consts::TAU);
         sz += (ze - zg).abs().to_degrees();
-        sa += da.min(std::f64::consts::TAU - da).to_degrees();
+        let ad = da.min(std::f64::consts::TAU - da).to_degrees();
+        sa += ad;
+        if std::env::var("AZBINS").is_ok() && zg.to_degrees() > 15.0 {
+            eprintln!("AZ {}", (ad / 45.0).round() as i32);
+        }
         n += 1.0;
     }
     (sz / n, sa / n)

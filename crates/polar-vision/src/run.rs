@@ -134,6 +134,7 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
         out,
         radiance_per_unit: radiance_per_unit(&file, dir, &obs, &gt)?,
         normals: None,
+        objects: None,
         transparent: None,
     };
     let (w, h) = obs.size();

@@ -10,13 +10,14 @@ use super::{Context, Failure, Outcome, io, knn_message, picture_path, to_json};
 use crate::pictures::{MATERIAL_PALETTE, label_picture};
 use crate::task_options::TaskArgs;
 
-/// Runs the task with the normals and transparency mask of earlier tasks, where they ran.
+/// Runs the task with the normals, object mask and transparency mask of earlier tasks,
+/// where they ran (one foreground for both tasks: sfp's follows the occluding contours).
 pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     let clf = args.material_classifier()?;
     let map = classify(
         ctx.obs,
         ctx.normals.as_ref(),
-        None,
+        ctx.objects.as_ref(),
         ctx.transparent.as_ref(),
         &clf,
         &MaterialOptions::default(),

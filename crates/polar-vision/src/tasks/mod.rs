@@ -64,6 +64,8 @@ pub struct Context<'a> {
     pub radiance_per_unit: Option<f64>,
     /// Normals from `sfp`, for `material`.
     pub normals: Option<NormalImage>,
+    /// Object mask from `sfp` (255 on objects), for `material`.
+    pub objects: Option<Gray<u8>>,
     /// Transparency mask from `transparent`, for `material`.
     pub transparent: Option<Gray<u8>>,
 }

@@ -64,6 +64,7 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
         .map_err(io)?;
     }
     ctx.normals = Some(shape.normal);
+    ctx.objects = Some(shape.foreground);
     Ok(outcome)
 }
 
