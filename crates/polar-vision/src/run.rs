@@ -37,7 +37,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Tasks to run, comma-separated (default: all). They run in the order sfp,
-    /// transparent, material, dehaze; material uses sfp's normals and object mask and the transparency mask.
+    /// transparent, material, dehaze; material uses sfp's normals and object mask and
+    /// the transparency mask.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = Task::ALL)]
     pub tasks: Vec<Task>,
     /// Which file of a sample directory to read: raw (the camera's mosaic; the default
