@@ -231,7 +231,11 @@ def load(d: Path, meta):
 
 def check() -> int:
     """Regenerates into a temp dir; integer arrays and scalars must match exactly, float
-    arrays to 1e-6 of their largest magnitude (SIMD paths differ between CPUs by a few ulp)."""
+    arrays to 1e-6 of their largest magnitude (SIMD paths differ between CPUs by a few ulp),
+    except OpenCV's own guided filter output (`guided_*.dst`), held to 1e-4: its float32
+    division takes an approximate-reciprocal path whose width differs between CPUs (AVX2
+    against AVX-512 machines differ by up to 1.2e-5); the exact-reciprocal replay
+    (`dst_exact`), which the Rust tests compare against, keeps 1e-6."""
     with tempfile.TemporaryDirectory() as tmp:
         generate(Path(tmp))
         new = json.loads((Path(tmp) / "index.json").read_text())
@@ -247,7 +251,8 @@ def check() -> int:
             if a.shape != b.shape:
                 problems.append(f"{name}: shape {a.shape} vs {b.shape}")
             elif a.dtype.kind == "f":
-                tol = 1e-6 * max(1.0, float(np.nanmax(np.abs(b))))
+                rel = 1e-4 if name.startswith("guided_") and name.endswith(".dst") else 1e-6
+                tol = rel * max(1.0, float(np.nanmax(np.abs(b))))
                 err = float(np.nanmax(np.abs(a.astype(np.float64) - b)))
                 if err > tol:
                     problems.append(f"{name}: max abs diff {err:.3g} > {tol:.3g}")
