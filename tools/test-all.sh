@@ -29,14 +29,27 @@ step "image primitives vs opencv-contrib / scikit-image"
 step "task metrics vs numpy / scikit-image"
 "$py" tools/eval_goldens.py --check
 
-step "dark-channel dehazing vs OpenCV (regenerated goldens equal the committed ones)"
+step "dark-channel dehazing vs OpenCV (regenerated goldens match the committed ones)"
 tmp="$(mktemp -d)"
 "$py" tools/dehaze_dcp_reference.py "$tmp/s0.bin" --synthetic 64 48 --width 64 --height 48 \
     --out-t "$tmp/t.bin" --out-radiance "$tmp/radiance.bin"
 golden=crates/polar-dehaze/tests/golden
-cmp "$golden/dcp_s0.bin" "$tmp/s0.bin"
-cmp "$golden/dcp_t.bin" "$tmp/t.bin"
-cmp "$golden/dcp_radiance.bin" "$tmp/radiance.bin"
+# The input is exact; OpenCV's float32 guided filter takes CPU-dependent SIMD paths
+# (7e-6 in t and 7e-6 of the radiance range between AVX2 and AVX-512 machines), so the
+# outputs are held to 1e-5 of their range, 100x below the Rust test's tolerances.
+"$py" - "$golden" "$tmp" <<'PY'
+import sys
+import numpy as np
+golden, new = sys.argv[1], sys.argv[2]
+for name, rel in (("s0", 0.0), ("t", 1e-5), ("radiance", 1e-5)):
+    a = np.fromfile(f"{golden}/dcp_{name}.bin", "<f4")
+    b = np.fromfile(f"{new}/{name}.bin", "<f4")
+    err = float(np.abs(a.astype(np.float64) - b).max()) if a.shape == b.shape else np.inf
+    tol = rel * max(1.0, float(np.abs(a).max()))
+    print(f"dcp_{name}: max abs diff {err:.3g} (tolerance {tol:.3g})")
+    if err > tol:
+        sys.exit(f"dcp_{name}.bin drifted from the committed golden")
+PY
 rm -rf "$tmp"
 
 step "front end vs polanalyser"
