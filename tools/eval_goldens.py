@@ -19,6 +19,7 @@ from skimage.metrics import peak_signal_noise_ratio, structural_similarity
 GOLDEN = Path(__file__).resolve().parent.parent / "crates/polar-eval/tests/golden/eval.json"
 W, H = 24, 16
 SEED = 20261202
+REACHABLE_T = np.float32(0.1)  # polar_eval::REACHABLE_TRANSMISSION
 
 
 def depth_fit(est, gt, mask):
@@ -53,9 +54,13 @@ def dehaze_case(hazy, dehazed, ref, t_est, t_gt):
     score = lambda x: {"psnr_db": peak_signal_noise_ratio(ref, x, data_range=r),
                        "ssim": structural_similarity(ref, x, data_range=r, gaussian_weights=True,
                                                      sigma=1.5, use_sample_covariance=False)}
+    reach = t_gt >= REACHABLE_T
+    mse = lambda x: np.mean((x[reach] - ref[reach]).astype(np.float64) ** 2)
     return {"hazy": score(hazy), "dehazed": score(dehazed),
             "transmission_mae": float(np.mean(np.abs(t_est.astype(np.float64) - t_gt))),
-            "transmission_correlation": float(np.corrcoef(t_est.ravel(), t_gt.ravel())[0, 1])}
+            "transmission_correlation": float(np.corrcoef(t_est.ravel(), t_gt.ravel())[0, 1]),
+            "reachable": {"fraction": reach.mean(), "hazy_psnr_db": 10 * np.log10(r * r / mse(hazy)),
+                          "dehazed_psnr_db": 10 * np.log10(r * r / mse(dehazed))}}
 
 
 def make():

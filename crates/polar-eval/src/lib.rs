@@ -12,8 +12,8 @@ mod tasks;
 pub use aggregate::{Aggregate, Summary, aggregate, family_of};
 pub use depth::{DepthFit, depth_fit};
 pub use tasks::{
-    DehazeMetrics, ImageScore, MaskMetrics, MaterialMetrics, NormalMetrics, dehaze_metrics,
-    mask_metrics, material_metrics, normal_metrics, pearson,
+    DehazeMetrics, ImageScore, MaskMetrics, MaterialMetrics, NormalMetrics, REACHABLE_TRANSMISSION,
+    ReachableScore, dehaze_metrics, mask_metrics, material_metrics, normal_metrics, pearson,
 };
 
 use thiserror::Error;

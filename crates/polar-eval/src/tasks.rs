@@ -188,6 +188,27 @@ pub struct DehazeMetrics {
     pub transmission_mae: Option<f64>,
     /// Pearson correlation of estimated and true transmission.
     pub transmission_correlation: Option<f64>,
+    /// PSNR over the pixels whose radiance the image still holds (true transmission at
+    /// least [`REACHABLE_TRANSMISSION`]), where the truth is known and such pixels exist.
+    pub reachable: Option<ReachableScore>,
+}
+
+/// Pixels whose true transmission is below this are left out of [`ReachableScore`]: less
+/// than a tenth of their radiance reaches the camera, so any inversion multiplies the
+/// sensor's noise and quantization more than tenfold, and sky seen through a deep haze
+/// (`t` near 0) holds no trace of the haze-free sky at all.
+pub const REACHABLE_TRANSMISSION: f32 = 0.1;
+
+/// PSNR of the hazy input and the dehazed output over the reachable pixels, with the
+/// data range of the whole frame's score.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReachableScore {
+    /// Share of the frame's pixels that are reachable.
+    pub fraction: f64,
+    /// Hazy S0 against the reference, dB.
+    pub hazy_psnr_db: f64,
+    /// Dehazed radiance against the reference, dB.
+    pub dehazed_psnr_db: f64,
 }
 
 /// Scores a dehazing result over the whole frame. The data range of PSNR and SSIM is the
@@ -212,9 +233,10 @@ pub fn dehaze_metrics(
             ssim: ssim(reference, img, range)?,
         })
     };
-    let (mae, corr) = match transmission {
+    let (mae, corr, reachable) = match transmission {
         Some((est, gt)) => {
             check_size("transmission", est.size(), gt.size())?;
+            check_size("true transmission", gt.size(), reference.size())?;
             let n = est.as_slice().len().max(1) as f64;
             let mae = est
                 .as_slice()
@@ -223,15 +245,42 @@ pub fn dehaze_metrics(
                 .map(|(a, b)| f64::from((a - b).abs()))
                 .sum::<f64>()
                 / n;
-            (Some(mae), pearson(est.as_slice(), gt.as_slice()))
+            let reachable = reachable_score(hazy, dehazed, reference, gt, range);
+            (Some(mae), pearson(est.as_slice(), gt.as_slice()), reachable)
         }
-        None => (None, None),
+        None => (None, None, None),
     };
     Ok(DehazeMetrics {
         hazy: score(hazy)?,
         dehazed: score(dehazed)?,
         transmission_mae: mae,
         transmission_correlation: corr,
+        reachable,
+    })
+}
+
+/// [`ReachableScore`] of same-sized images; `None` where no pixel is reachable.
+fn reachable_score(
+    hazy: &Gray<f32>,
+    dehazed: &Gray<f32>,
+    reference: &Gray<f32>,
+    t_true: &Gray<f32>,
+    range: f64,
+) -> Option<ReachableScore> {
+    let keep: Vec<usize> = (t_true.as_slice().iter().enumerate())
+        .filter(|(_, t)| **t >= REACHABLE_TRANSMISSION)
+        .map(|(k, _)| k)
+        .collect();
+    let r = reference.as_slice();
+    let psnr = |img: &Gray<f32>| {
+        let x = img.as_slice();
+        let sse: f64 = keep.iter().map(|&k| f64::from(x[k] - r[k]).powi(2)).sum();
+        10.0 * (range * range * keep.len() as f64 / sse).log10()
+    };
+    (!keep.is_empty()).then(|| ReachableScore {
+        fraction: keep.len() as f64 / r.len() as f64,
+        hazy_psnr_db: psnr(hazy),
+        dehazed_psnr_db: psnr(dehazed),
     })
 }
 
@@ -293,6 +342,31 @@ mod tests {
         let empty = gray(5, vec![0u8; 5]);
         let m = mask_metrics(&empty, &empty, None).unwrap();
         assert_eq!((m.iou, m.precision, m.recall), (None, None, None));
+    }
+
+    #[test]
+    fn reachable_score_leaves_out_pixels_the_haze_hid() {
+        // 12x12 (SSIM's window needs 11x11): the reference is 1 everywhere; the output is
+        // off by 1 at pixel 0, which the haze hid (t = 0.05), and by 0.1 at pixel 1 (t = 0.5).
+        let n = 144;
+        let reference = gray(12, vec![1.0f32; n]);
+        let mut dehazed = vec![1.0f32; n];
+        (dehazed[0], dehazed[1]) = (0.0, 0.9);
+        let dehazed = gray(12, dehazed);
+        let hazy = gray(12, vec![0.8f32; n]);
+        let mut t = vec![1.0f32; n];
+        (t[0], t[1]) = (0.05, 0.5);
+        let t = gray(12, t);
+        let m = dehaze_metrics(&hazy, &dehazed, &reference, Some((&t, &t))).unwrap();
+        let r = m.reachable.unwrap();
+        assert_eq!(r.fraction, 143.0 / 144.0);
+        let want = |sse: f64| 10.0 * (143.0 / sse).log10();
+        assert!((r.dehazed_psnr_db - want(0.01)).abs() < 1e-4, "{r:?}");
+        assert!((r.hazy_psnr_db - want(143.0 * 0.04)).abs() < 1e-4, "{r:?}");
+        assert!(m.dehazed.psnr_db < r.dehazed_psnr_db - 10.0);
+        let hidden = gray(12, vec![0.0f32; n]);
+        let m = dehaze_metrics(&hazy, &dehazed, &reference, Some((&t, &hidden))).unwrap();
+        assert_eq!(m.reachable, None);
     }
 
     #[test]

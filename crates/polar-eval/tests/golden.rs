@@ -180,4 +180,19 @@ fn dehaze_metrics_match_scikit_image_and_numpy() {
         1e-9,
         "correlation",
     );
+    // Squared differences summed in f64 on both sides: only the order of the sum differs.
+    let r = m.reachable.expect("some true transmission >= 0.1");
+    assert_rel(
+        r.fraction,
+        g.expected("dehaze.reachable.fraction"),
+        1e-12,
+        "fraction",
+    );
+    for (got, key) in [
+        (r.hazy_psnr_db, "hazy_psnr_db"),
+        (r.dehazed_psnr_db, "dehazed_psnr_db"),
+    ] {
+        let want = g.expected(&format!("dehaze.reachable.{key}"));
+        assert_rel(got, want, 1e-9, key);
+    }
 }
