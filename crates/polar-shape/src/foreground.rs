@@ -15,7 +15,15 @@
 //! 3. the edge-free 4-connected regions touching the border are background; the rest
 //!    (enclosed regions, the edges around them, invalid pixels such as saturated
 //!    highlights inside an object) is the foreground, eroded by 3×3 (undoing the
-//!    dilation) and opened by 3×3 to drop thin edge lines.
+//!    dilation) and opened by 3×3 to drop thin edge lines;
+//! 4. of the edge-free interiors only object faces count ([`object_faces`]): those B
+//!    holds (a tenth of the ring around them is B: a face inside its coherent rim),
+//!    those polarized above the background (median DoLP twice the background's: a
+//!    glossy face whose AoLP varies too fast for B) and those whose rim shows the
+//!    occluding-contour signature below (a weakly polarized object); with the edges
+//!    near them or near B. Edges also enclose cast shadows and floor texture: they are
+//!    depolarized, their outline shows no contour, and B touches a shadow only along
+//!    its contact line with the object.
 //!
 //! **B. Coherently polarized regions** (for silhouettes too weak
 //! to be enclosed by A, e.g. a bright object on a bright floor):
@@ -41,16 +49,17 @@
 //! **The union**: B's regions, and A's outside the holes B left open. A's edge-free
 //! interiors that B does not touch and that the rest of the foreground encloses are
 //! opened by the same brightness test ([`open_see_through_holes`]): edges also enclose
-//! the hole of a torus. Components without any pixel of B are dropped (floor texture
-//! enclosed by edges; every object polarizes somewhere). Regions inside the frame are
+//! the hole of a torus. Components without any pixel of B or of an object face are
+//! dropped (specks; every object polarizes somewhere). Regions inside the frame are
 //! not held to the contour signature: on glossy objects the diffuse and specular parts
 //! cancel along stretches of the rim, and the shape prior checks it per boundary pixel
 //! instead (`crate::local`).
 //!
 //! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
 //! the view, a tiny image), every valid pixel is foreground: the frame shows one surface
-//! and no occluding contour. A fails where a shadow or floor texture is enclosed by
-//! edges (it takes them in); B fails on objects whose polarization is too weak or
+//! and no occluding contour. A fails on an object that is neither coherently polarized
+//! nor shows a contour signature (a bright diffuse object on a bright floor: it is
+//! dropped with the shadows); B fails on objects whose polarization is too weak or
 //! broken up to form a coherent field at the window's scale.
 
 use std::collections::VecDeque;
@@ -95,6 +104,19 @@ const EDGE_BAND: u32 = 4;
 /// Fraction of the ring around an interior region that must be foreground for the
 /// region to be a hole.
 const HOLE_ENCLOSURE: f64 = 0.9;
+/// Fraction of the ring around an edge-free interior that must be cue B for the interior
+/// to be an object face: a face inside a coherent rim has far more, floor texture none;
+/// a cast shadow touches B along its contact line with the object, a few percent of its
+/// ring (0.05-0.3 scored the same on the dev and Mitsuba sets).
+const HELD_BY_B: f64 = 0.1;
+/// Significance (standard deviations) of the occluding-contour signature that makes an
+/// interior B does not hold an object face (a weakly polarized object): lower than
+/// [`CONTOUR_SIGNIFICANCE`], as the rim is short and only this test speaks for it.
+const FACE_CONTOUR_SIGNIFICANCE: f64 = 2.0;
+/// Median DoLP, in units of the background's median DoLP (the depolarizing floor's noise
+/// and demosaicing residue), above which an interior is a polarized object face: a glossy
+/// or dark dielectric whose AoLP varies too fast for cue B (the real camera's body).
+const FACE_DOLP_FACTOR: f32 = 2.0;
 
 /// Foreground mask (`true` on objects) of the cues (module doc).
 pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
@@ -106,16 +128,23 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     if w < 3 || h < 3 {
         return Ok(cues.valid.clone());
     }
-    let enclosed = enclosed_by_edges(cues)?;
     let coherent = coherent_with_holes(cues)?;
+    let faces = object_faces(cues, enclosed_by_edges(cues)?, &coherent.regions)?;
+    let enclosed = &faces.enclosed;
     let fg: Vec<bool> = (0..w * h)
         .map(|k| {
             cues.valid[k]
                 && (coherent.regions[k] || (enclosed.regions[k] && !coherent.open_holes[k]))
         })
         .collect();
-    let fg = open_see_through_holes(cues, fg, &enclosed, &coherent.regions)?;
-    let fg = with_coherent_part(fg, &coherent.regions, w, h)?;
+    let polarized: Vec<bool> = (0..w * h)
+        .map(|k| coherent.regions[k] || faces.polarized[k])
+        .collect();
+    let fg = open_see_through_holes(cues, fg, enclosed, &polarized)?;
+    let evidence: Vec<bool> = (0..w * h)
+        .map(|k| coherent.regions[k] || enclosed.interiors[k])
+        .collect();
+    let fg = with_evidence(fg, &evidence, w, h)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -152,18 +181,146 @@ pub(crate) fn enclosed_by_edges(cues: &Cues) -> Result<Enclosed, ShapeError> {
     })
 }
 
-/// `fg` without the edge-free interiors (not touching cue B) that are holes of the rest
-/// of `fg` and look like the background seen through them (see [`looks_through`]).
+/// Cue A kept to its object faces ([`object_faces`]).
+struct Faces {
+    enclosed: Enclosed,
+    /// Pixels of faces polarized above the background ([`FACE_DOLP_FACTOR`]).
+    polarized: Vec<bool>,
+}
+
+/// Cue A restricted to its object faces (module doc, A.4) and to the edges that go with
+/// them ([`face_edges`]); all of A when B is empty.
+fn object_faces(cues: &Cues, enclosed: Enclosed, coherent: &[bool]) -> Result<Faces, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    if !coherent.iter().any(|&v| v) {
+        return Ok(Faces {
+            enclosed,
+            polarized: vec![false; w * h],
+        });
+    }
+    let (id, n) = components(&enclosed.interiors, w, h)?;
+    let verdicts = face_interiors(cues, &enclosed, coherent, &id, n)?;
+    let face: Vec<bool> = id.iter().map(|&i| verdicts[i as usize].face).collect();
+    let edges = face_edges(&enclosed, coherent, &id, &face, w, h)?;
+    Ok(Faces {
+        polarized: id.iter().map(|&i| verdicts[i as usize].polarized).collect(),
+        enclosed: Enclosed {
+            regions: (0..w * h)
+                .map(|k| enclosed.regions[k] && edges[k] && (id[k] == 0 || face[k]))
+                .collect(),
+            interiors: (0..w * h)
+                .map(|k| enclosed.interiors[k] && face[k])
+                .collect(),
+        },
+    })
+}
+
+/// The edge pixels of cue A that go with the object faces (`face`, per pixel) and B:
+/// those within [`EDGE_BAND`] steps of them, those nearer to them than to any other
+/// edge-free region (wide edges of a blurred or high-resolution image), and those the
+/// two enclose.
+fn face_edges(
+    enclosed: &Enclosed,
+    coherent: &[bool],
+    id: &[u32],
+    face: &[bool],
+    w: usize,
+    h: usize,
+) -> Result<Vec<bool>, ShapeError> {
+    let object = |k: usize| coherent[k] || face[k];
+    let seeds: Vec<u32> = (0..w * h).map(|k| u32::from(object(k))).collect();
+    let (_, near) = grow_labels(&seeds, w, h, EDGE_BAND, |_| true);
+    // Edge-free regions: objects (1), other interiors (2), the background (3).
+    let regions: Vec<u32> = (0..w * h)
+        .map(|k| match (object(k), id[k] > 0, enclosed.regions[k]) {
+            (true, _, _) => 1,
+            (false, true, _) => 2,
+            (false, false, false) => 3,
+            (false, false, true) => 0,
+        })
+        .collect();
+    let (nearest, _) = grow_labels(&regions, w, h, u32::MAX - 1, |_| true);
+    let kept: Vec<bool> = (0..w * h)
+        .map(|k| near[k] != u32::MAX || nearest[k] == 1)
+        .collect();
+    Ok(fill_holes(&kept, w, h)?)
+}
+
+/// What [`face_interiors`] finds of one interior.
+#[derive(Clone, Copy, Default)]
+struct Verdict {
+    face: bool,
+    polarized: bool,
+}
+
+/// Per interior label of `id` (`n` labels; index 0 outside them): it is an object face
+/// when at least [`HELD_BY_B`] of the pixels within [`RING_FAR`] steps around it are B,
+/// when its median DoLP is above [`FACE_DOLP_FACTOR`] times the background's (then it is
+/// also `polarized`), or when its rim (the interior grown by [`EDGE_BAND`] steps through
+/// A) shows the occluding-contour signature at [`FACE_CONTOUR_SIGNIFICANCE`].
+fn face_interiors(
+    cues: &Cues,
+    enclosed: &Enclosed,
+    coherent: &[bool],
+    id: &[u32],
+    n: usize,
+) -> Result<Vec<Verdict>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let (owner, dist) = grow_labels(id, w, h, RING_FAR, |_| true);
+    // Per interior: ring pixels, ring pixels in B.
+    let mut counts = vec![[0usize; 2]; n + 1];
+    for k in (0..w * h).filter(|&k| dist[k] != u32::MAX && dist[k] > 0) {
+        let c = &mut counts[owner[k] as usize];
+        c[0] += 1;
+        c[1] += usize::from(coherent[k]);
+    }
+    let background = median(
+        (0..w * h)
+            .filter(|&k| cues.valid[k] && !enclosed.regions[k] && !enclosed.interiors[k])
+            .map(|k| cues.dolp[k])
+            .collect(),
+    );
+    let mut dolp: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    for k in (0..w * h).filter(|&k| id[k] > 0 && cues.valid[k]) {
+        dolp[id[k] as usize].push(cues.dolp[k]);
+    }
+    let (rim_id, rim_dist) = grow_labels(id, w, h, EDGE_BAND, |k| enclosed.regions[k]);
+    let rim: Vec<bool> = rim_dist.iter().map(|&d| d != u32::MAX).collect();
+    let sums = contour_sums(cues, &rim, &rim_id, n)?;
+    Ok((0..=n)
+        .map(|c| {
+            if c == 0 {
+                return Verdict::default();
+            }
+            let polarized = matches!(
+                (median(std::mem::take(&mut dolp[c])), background),
+                (Some(d), Some(b)) if d > FACE_DOLP_FACTOR * b
+            );
+            let [cos, rho, rho2] = sums[c];
+            let held = counts[c][1] as f64 >= HELD_BY_B * counts[c][0] as f64;
+            let contour = rho > 0.0 && cos > FACE_CONTOUR_SIGNIFICANCE * (0.5 * rho2).sqrt();
+            Verdict {
+                face: held || polarized || contour,
+                polarized,
+            }
+        })
+        .collect())
+}
+
+/// `fg` without the edge-free interiors that are holes of the rest of `fg` and look like
+/// the background seen through them (see [`looks_through`]); interiors holding a pixel
+/// of `polarized` (cue B, or a face polarized above the background) show no
+/// depolarizing background and stay.
 pub(crate) fn open_see_through_holes(
     cues: &Cues,
     fg: Vec<bool>,
     enclosed: &Enclosed,
-    coherent: &[bool],
+    polarized: &[bool],
 ) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let (id, n) = components(&enclosed.interiors, w, h)?;
     let mut touches_b = vec![false; n + 1];
-    for k in (0..w * h).filter(|&k| coherent[k]) {
+    for k in (0..w * h).filter(|&k| polarized[k]) {
         touches_b[id[k] as usize] = true;
     }
     let outside = median(
@@ -215,24 +372,24 @@ pub(crate) fn open_see_through_holes(
     Ok(out)
 }
 
-/// The 8-connected components of `fg` that hold a pixel of cue B (`coherent`), or all
-/// of `fg` when B found nothing: every object polarizes somewhere, so an enclosed region
-/// without any coherent polarization is floor texture or a speck.
-fn with_coherent_part(
+/// The 8-connected components of `fg` that hold a pixel of `evidence` (cue B or an
+/// object face of A), or all of `fg` when there is none: every object polarizes
+/// somewhere, so a region without either is floor texture or a speck.
+fn with_evidence(
     fg: Vec<bool>,
-    coherent: &[bool],
+    evidence: &[bool],
     w: usize,
     h: usize,
 ) -> Result<Vec<bool>, ShapeError> {
-    if !coherent.iter().any(|&v| v) {
+    if !evidence.iter().any(|&v| v) {
         return Ok(fg);
     }
     let (id, n) = components(&fg, w, h)?;
-    let mut has_b = vec![false; n + 1];
-    for k in (0..w * h).filter(|&k| coherent[k]) {
-        has_b[id[k] as usize] = true;
+    let mut has = vec![false; n + 1];
+    for k in (0..w * h).filter(|&k| evidence[k]) {
+        has[id[k] as usize] = true;
     }
-    Ok((0..w * h).map(|k| fg[k] && has_b[id[k] as usize]).collect())
+    Ok((0..w * h).map(|k| fg[k] && has[id[k] as usize]).collect())
 }
 
 /// A hole whose median log brightness is closer to the background's around the objects
@@ -489,6 +646,28 @@ fn inner_or_with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeErro
     if n == 0 {
         return Ok(m.to_vec());
     }
+    let sums = contour_sums(cues, m, &id, n)?;
+    let mut at_border = vec![false; n + 1];
+    for k in (0..w * h).filter(|&k| m[k]) {
+        let (x, y) = (k % w, k / w);
+        at_border[id[k] as usize] |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+    }
+    let keep: Vec<bool> = (0..=n)
+        .map(|c| !at_border[c] || has_contour(sums[c][0], sums[c][1], sums[c][2]))
+        .collect();
+    Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
+}
+
+/// Per label of `id` (`n` labels over the pixels of `m`), the sums [`has_contour`] tests
+/// over the label's boundary pixels: `Σ ρ cos 4Δ`, `Σ ρ`, `Σ ρ²`, with `Δ` the AoLP
+/// against the outward normal of `m`'s smoothed boundary.
+fn contour_sums(
+    cues: &Cues,
+    m: &[bool],
+    id: &[u32],
+    n: usize,
+) -> Result<Vec<[f64; 3]>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
     let mask =
         Gray::from_vec(w, h, m.iter().map(|&b| f32::from(u8::from(b))).collect()).expect("sized");
     let mut smooth = Gray::new(w, h);
@@ -496,15 +675,11 @@ fn inner_or_with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeErro
     let (mut gx, mut gy) = (Gray::new(w, h), Gray::new(w, h));
     sobel(&smooth, &mut gx, 1, 0, 3)?;
     sobel(&smooth, &mut gy, 0, 1, 3)?;
-    // Per component: Σ ρ cos 4Δ, Σ ρ, Σ ρ².
     let mut sums = vec![[0.0f64; 3]; n + 1];
-    let mut at_border = vec![false; n + 1];
-    for k in (0..w * h).filter(|&k| m[k]) {
-        let (x, y) = (k % w, k / w);
-        at_border[id[k] as usize] |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+    for k in (0..w * h).filter(|&k| m[k] && cues.valid[k]) {
         // Outward normal = −∇(smoothed mask); a unit ramp gives a Sobel response of 8.
         let (dx, dy) = (-f64::from(gx.as_slice()[k]), -f64::from(gy.as_slice()[k]));
-        if !cues.valid[k] || dx.hypot(dy) / 8.0 < BOUNDARY_GRADIENT {
+        if dx.hypot(dy) / 8.0 < BOUNDARY_GRADIENT {
             continue;
         }
         let normal = image_direction_angle(&cues.frame(k), dx, dy);
@@ -514,10 +689,7 @@ fn inner_or_with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeErro
         s[1] += rho;
         s[2] += rho * rho;
     }
-    let keep: Vec<bool> = (0..=n)
-        .map(|c| !at_border[c] || has_contour(sums[c][0], sums[c][1], sums[c][2]))
-        .collect();
-    Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
+    Ok(sums)
 }
 
 /// The occluding-contour test of a boundary from `Σ ρ cos 4Δ`, `Σ ρ` and `Σ ρ²` over its
