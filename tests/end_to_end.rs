@@ -189,11 +189,16 @@ fn shape_from_polarization_on_the_ci_shape_family() {
     let (dir, m) = eval("sfp", "sfp", "2");
     let mean = family_mean(&m, "sfp", "sfp", "normal.mean_deg");
     let median = family_mean(&m, "sfp", "sfp", "normal.median_deg");
-    eprintln!("sfp ci: mean {mean:.2} deg, median {median:.2} deg");
+    let coverage = family_mean(&m, "sfp", "sfp", "normal.coverage");
+    eprintln!("sfp ci: mean {mean:.2} deg, median {median:.2} deg, coverage {coverage:.3}");
     assert!(
         median < SFP_CI_MEDIAN_DEG && mean < SFP_CI_MEAN_DEG,
         "mean {mean}, median {median}"
     );
+    // The angles are over the object pixels given a normal: a foreground that left most
+    // of the objects out could pass the bounds above. Measured 0.77 on these 4 samples
+    // (0.90 on the dev set); 0.7 leaves room for a few boundary pixels either way.
+    assert!(coverage > 0.7, "coverage {coverage}");
     worst_sfp_samples_are_shown(dir.path(), &m);
 }
 

@@ -14,6 +14,9 @@ use crate::{EvalError, check_size};
 pub struct NormalMetrics {
     /// Pixels scored.
     pub count: usize,
+    /// Share of the object pixels with a true normal that have an estimate (the angles
+    /// are over those only, so a method that leaves hard pixels out scores better).
+    pub coverage: f64,
     /// Mean angle.
     pub mean_deg: f64,
     /// Median angle.
@@ -33,9 +36,10 @@ pub struct NormalMetrics {
 }
 
 impl NormalMetrics {
-    fn from_stats(s: AngularErrorStats) -> Self {
+    fn from_stats(s: AngularErrorStats, objects: usize) -> Self {
         Self {
             count: s.count,
+            coverage: s.count as f64 / objects.max(1) as f64,
             mean_deg: s.mean,
             median_deg: s.median,
             rmse_deg: s.rmse,
@@ -62,7 +66,10 @@ pub fn normal_metrics(
     let Some(stats) = angular_error(est, truth, Some(objects))? else {
         return Ok(None);
     };
-    let mut out = NormalMetrics::from_stats(stats);
+    let with_truth = (truth.pixels().iter().zip(objects.as_slice()))
+        .filter(|(n, m)| **m != 0 && n.iter().any(|&c| c != 0.0))
+        .count();
+    let mut out = NormalMetrics::from_stats(stats, with_truth);
     if let Some((classes, names)) = types {
         check_size("reflection types", classes.size(), truth.size())?;
         for (value, name) in names.iter().enumerate() {
@@ -405,5 +412,17 @@ mod tests {
         assert_eq!(m.mean_deg_by_type.get("a"), Some(&0.0));
         assert!((m.mean_deg_by_type["b"] - 90.0).abs() < 1e-9);
         assert!(!m.mean_deg_by_type.contains_key("none"));
+        assert_eq!(m.coverage, 1.0);
+        // An object pixel left without an estimate lowers the coverage, not the mean.
+        let missed = NormalImage::from_vec(
+            3,
+            1,
+            [n([0., 0., 1.]), n([0., 0., 0.]), n([0., 1., 0.])].concat(),
+        )
+        .unwrap();
+        let m = normal_metrics(&missed, &truth, &objects, None, None)
+            .unwrap()
+            .unwrap();
+        assert_eq!((m.count, m.coverage, m.mean_deg), (1, 0.5, 0.0));
     }
 }

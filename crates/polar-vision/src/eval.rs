@@ -300,8 +300,13 @@ fn write_report(
 }
 
 /// The headline figures of each task, in the order a reader looks for them.
-const HEADLINES: [(&str, &str, &str); 12] = [
+const HEADLINES: [(&str, &str, &str); 13] = [
     ("sfp", "normal.mean_deg", "mean angular error (deg)"),
+    (
+        "sfp",
+        "normal.coverage",
+        "share of object pixels with a normal",
+    ),
     ("sfp", "normal.median_deg", "median angular error (deg)"),
     ("sfp", "normal.depth.relative_rmse", "depth RMSE / range"),
     (
