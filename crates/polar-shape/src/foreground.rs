@@ -296,9 +296,8 @@ fn face_interiors(
                 (median(std::mem::take(&mut dolp[c])), background),
                 (Some(d), Some(b)) if d > FACE_DOLP_FACTOR * b
             );
-            let [cos, rho, rho2] = sums[c];
             let held = counts[c][1] as f64 >= HELD_BY_B * counts[c][0] as f64;
-            let contour = rho > 0.0 && cos > FACE_CONTOUR_SIGNIFICANCE * (0.5 * rho2).sqrt();
+            let contour = contour_above(sums[c], FACE_CONTOUR_SIGNIFICANCE);
             Verdict {
                 face: held || polarized || contour,
                 polarized,
@@ -319,9 +318,9 @@ pub(crate) fn open_see_through_holes(
 ) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let (id, n) = components(&enclosed.interiors, w, h)?;
-    let mut touches_b = vec![false; n + 1];
+    let mut holds_polarization = vec![false; n + 1];
     for k in (0..w * h).filter(|&k| polarized[k]) {
-        touches_b[id[k] as usize] = true;
+        holds_polarization[id[k] as usize] = true;
     }
     let outside = median(
         ring(&fg, w, h, 1..=RING_FAR)
@@ -332,7 +331,7 @@ pub(crate) fn open_see_through_holes(
     );
     let candidates: Vec<u32> = id
         .iter()
-        .map(|&i| if touches_b[i as usize] { 0 } else { i })
+        .map(|&i| if holds_polarization[i as usize] { 0 } else { i })
         .collect();
     let (owner, dist) = grow_labels(&candidates, w, h, EDGE_BAND + RING_FAR, |_| true);
     // Per interior: ring pixels, ring pixels in fg; brightness of the interior and of
@@ -653,7 +652,7 @@ fn inner_or_with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeErro
         at_border[id[k] as usize] |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
     }
     let keep: Vec<bool> = (0..=n)
-        .map(|c| !at_border[c] || has_contour(sums[c][0], sums[c][1], sums[c][2]))
+        .map(|c| !at_border[c] || contour_above(sums[c], CONTOUR_SIGNIFICANCE))
         .collect();
     Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
 }
@@ -697,5 +696,10 @@ fn contour_sums(
 /// deviations of its value for independent random AoLP (`cos 4Δ` has mean 0 and
 /// variance ½, so the standard deviation is `√(Σρ²/2) / Σρ`).
 pub(crate) fn has_contour(weighted_cos: f64, weight: f64, weight_sq: f64) -> bool {
-    weight > 0.0 && weighted_cos > CONTOUR_SIGNIFICANCE * (0.5 * weight_sq).sqrt()
+    contour_above([weighted_cos, weight, weight_sq], CONTOUR_SIGNIFICANCE)
+}
+
+/// [`has_contour`] at `significance` standard deviations, from the three sums.
+fn contour_above([weighted_cos, weight, weight_sq]: [f64; 3], significance: f64) -> bool {
+    weight > 0.0 && weighted_cos > significance * (0.5 * weight_sq).sqrt()
 }

@@ -452,11 +452,7 @@ fn mask_iou(fg: &[bool], truth: &[bool]) -> f64 {
 /// cells with a dark elliptical cast shadow on the right; everything carries
 /// polarization noise.
 fn sphere_on_textured_floor() -> (Scene, Vec<bool>) {
-    let centre = Vector3::new(-0.6, 0.0, -5.0);
-    let l = light();
-    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.5, |d| {
-        sphere_hit(d, centre, 0.6).map(|n| (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2)))
-    });
+    let (mut scene, _) = left_sphere();
     let mut shadow = vec![false; 96 * 96];
     for (k, s) in scene.stokes.iter_mut().enumerate() {
         if scene.normals[k].norm_squared() > 0.0 {
@@ -499,26 +495,44 @@ fn textured_floor_and_cast_shadow_are_not_coherent_foreground() {
     assert_eq!(far_floor, 0, "floor texture taken as foreground");
 }
 
+/// The diffuse sphere left of the centre of a 96x96 frame that the foreground tests use,
+/// and its true mask.
+fn left_sphere() -> (Scene, Vec<bool>) {
+    let centre = Vector3::new(-0.6, 0.0, -5.0);
+    let l = light();
+    let scene = Scene::render(96, 96, 30.0, 1.5, 0.5, |d| {
+        sphere_hit(d, centre, 0.6).map(|n| (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2)))
+    });
+    let mask = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    (scene, mask)
+}
+
+/// Darkens the pixels where `dark` holds to 0.3 of their brightness, unpolarized (a cast
+/// shadow or dark floor texture), and adds 2 % polarization noise everywhere.
+fn darken_with_noise(scene: &mut Scene, dark: impl Fn(usize) -> bool) {
+    for (k, st) in scene.stokes.iter_mut().enumerate() {
+        if dark(k) {
+            st[0] *= 0.3;
+        }
+    }
+    add_polarization_noise(scene, 0.02);
+}
+
 /// Edges enclose two dark unpolarized patches on the floor, away from the sphere, but
 /// no coherent polarization lies in them, so the union leaves them out; the sphere is
 /// kept.
 #[test]
 fn enclosed_floor_texture_without_polarization_is_not_foreground() {
-    let centre = Vector3::new(-0.6, 0.0, -5.0);
-    let l = light();
-    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.5, |d| {
-        sphere_hit(d, centre, 0.6).map(|n| (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2)))
-    });
+    let (mut scene, truth) = left_sphere();
     let patch = |k: usize| {
         let (x, y) = (k % 96, k / 96);
         (70..82).contains(&x) && ((10..22).contains(&y) || (70..82).contains(&y))
     };
-    for (k, st) in scene.stokes.iter_mut().enumerate() {
-        if patch(k) {
-            st[0] *= 0.3;
-        }
-    }
-    add_polarization_noise(&mut scene, 0.02);
+    darken_with_noise(&mut scene, patch);
     let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
     let enclosed = crate::foreground::enclosed_by_edges(&cues).unwrap();
     assert!(
@@ -528,11 +542,6 @@ fn enclosed_floor_texture_without_polarization_is_not_foreground() {
     let fg = crate::foreground::foreground(&cues).unwrap();
     let in_patches = (0..fg.len()).filter(|&k| fg[k] && patch(k)).count();
     assert_eq!(in_patches, 0, "floor patches taken as foreground");
-    let truth: Vec<bool> = scene
-        .normals
-        .iter()
-        .map(|n| n.norm_squared() > 0.0)
-        .collect();
     // As in the coherent-region tests: the sphere's silhouette to a pixel or two.
     let iou = mask_iou(&fg, &truth);
     assert!(iou > 0.8, "sphere IoU {iou}");
@@ -543,16 +552,7 @@ fn enclosed_floor_texture_without_polarization_is_not_foreground() {
 /// only, so it is not an object face and stays out; the sphere is kept.
 #[test]
 fn attached_cast_shadow_is_not_foreground() {
-    let centre = Vector3::new(-0.6, 0.0, -5.0);
-    let l = light();
-    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.5, |d| {
-        sphere_hit(d, centre, 0.6).map(|n| (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2)))
-    });
-    let sphere: Vec<bool> = scene
-        .normals
-        .iter()
-        .map(|n| n.norm_squared() > 0.0)
-        .collect();
+    let (mut scene, sphere) = left_sphere();
     // The shadow: a 26 x 14 block right of the sphere's centre row, from inside the
     // sphere's outline outwards (the sphere covers x ~ 17..60 at its centre row 48).
     let shadow = |k: usize| {
@@ -560,12 +560,7 @@ fn attached_cast_shadow_is_not_foreground() {
         !sphere[k] && (50..76).contains(&x) && (50..64).contains(&y)
     };
     assert!((0..96 * 96).filter(|&k| shadow(k)).count() > 200);
-    for (k, st) in scene.stokes.iter_mut().enumerate() {
-        if shadow(k) {
-            st[0] *= 0.3;
-        }
-    }
-    add_polarization_noise(&mut scene, 0.02);
+    darken_with_noise(&mut scene, shadow);
     let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
     let enclosed = crate::foreground::enclosed_by_edges(&cues).unwrap();
     assert!(
@@ -591,11 +586,7 @@ fn attached_cast_shadow_is_not_foreground() {
 /// but without an occluding contour, is not foreground; the sphere is.
 #[test]
 fn coherent_floor_reaching_the_border_is_not_foreground() {
-    let centre = Vector3::new(-0.6, 0.0, -5.0);
-    let l = light();
-    let mut scene = Scene::render(96, 96, 30.0, 1.5, 0.5, |d| {
-        sphere_hit(d, centre, 0.6).map(|n| (n, Kind::Diffuse, lambert(&n, &l, 0.8, 0.2)))
-    });
+    let (mut scene, truth) = left_sphere();
     let floor = |k: usize| k / 96 >= 80;
     for (k, st) in scene.stokes.iter_mut().enumerate() {
         if floor(k) {
@@ -609,11 +600,6 @@ fn coherent_floor_reaching_the_border_is_not_foreground() {
     let fg = crate::foreground::foreground(&cues).unwrap();
     let taken = (0..fg.len()).filter(|&k| fg[k] && floor(k)).count();
     assert_eq!(taken, 0, "the polarized floor taken as foreground");
-    let truth: Vec<bool> = scene
-        .normals
-        .iter()
-        .map(|n| n.norm_squared() > 0.0)
-        .collect();
     let iou = mask_iou(&fg, &truth);
     assert!(iou > 0.8, "sphere IoU {iou}");
 }
