@@ -269,12 +269,9 @@ fn dehazing_on_the_ci_haze_family() {
     // follow the truth.
     assert!(dehazed > hazy - 1.0, "dehazed {dehazed} dB, hazy {hazy} dB");
     assert!(corr > 0.8, "transmission correlation {corr}");
-    // The pixels whose radiance the image holds (true t >= 0.1) are scored apart, and a
-    // frame with none of them (sky only) would be left out of this mean: it must exist.
-    assert!(
-        reach_dehazed.is_finite() && reach_hazy.is_finite(),
-        "reachable {reach_dehazed} / {reach_hazy} dB"
-    );
+    // The pixels whose radiance the image holds (true t >= 0.1) are scored apart (the
+    // lookups above fail if no sample has any): there too the output must not lose more
+    // than 1 dB (measured +0.1 dB on these two samples).
     assert!(
         reach_dehazed > reach_hazy - 1.0,
         "reachable pixels: dehazed {reach_dehazed} dB, hazy {reach_hazy} dB"
