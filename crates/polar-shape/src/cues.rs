@@ -120,3 +120,11 @@ pub fn image_direction_angle(f: &PixelFrame, dx: f64, dy: f64) -> f64 {
     let v = nalgebra::Vector3::new(dx, -dy, 0.0);
     v.dot(&f.y_ref).atan2(v.dot(&f.x_ref))
 }
+
+/// The unit vector of the frame's plane along the image-plane direction `(dx, dy)`
+/// (image coordinates): `f.in_plane(image_direction_angle(f, dx, dy))`, without
+/// trigonometry; `None` for a zero direction.
+pub fn image_direction(f: &PixelFrame, dx: f64, dy: f64) -> Option<nalgebra::Vector3<f64>> {
+    let v = nalgebra::Vector3::new(dx, -dy, 0.0);
+    (f.x_ref * v.dot(&f.x_ref) + f.y_ref * v.dot(&f.y_ref)).try_normalize(1e-12)
+}

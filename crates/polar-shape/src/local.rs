@@ -36,9 +36,8 @@ use nalgebra::Vector3;
 use polar_image::Gray;
 use polar_imgproc::{Border, Connectivity, gaussian_blur, gaussian_kernel, label, sep_filter};
 use rayon::prelude::*;
-use std::f64::consts::{FRAC_PI_2, PI};
 
-use crate::cues::{Cues, image_direction_angle};
+use crate::cues::{Cues, image_direction, image_direction_angle};
 use crate::foreground::has_contour;
 use crate::{Estimate, ReflectionType, ShapeError};
 
@@ -75,20 +74,22 @@ pub fn disambiguate(cues: &Cues, fg: &[bool]) -> Result<Estimate, ShapeError> {
 /// [`disambiguate`] with a given prior.
 pub fn disambiguate_with(cues: &Cues, fg: &[bool], prior: &Prior) -> Result<Estimate, ShapeError> {
     let n = cues.len();
+    let bounds: Vec<Option<Bounds>> = (0..n)
+        .into_par_iter()
+        .map(|k| fg[k].then(|| Bounds::of(cues, k)))
+        .collect();
+    let none = (Vector3::zeros(), ReflectionType::None, 0.0);
+    let mut chosen: Vec<_> = (0..n).into_par_iter().map(|_| none).collect();
     let mut field = prior.normal.clone();
-    let mut chosen: Vec<(Vector3<f64>, ReflectionType, f64)> = Vec::new();
+    let mut planes = FieldPlanes::new(cues.width, cues.height);
     for _ in 0..ITERATIONS {
-        chosen = (0..n)
-            .into_par_iter()
-            .map(|k| {
-                if fg[k] {
-                    choose(cues, k, &field[k])
-                } else {
-                    (Vector3::zeros(), ReflectionType::None, 0.0)
-                }
-            })
-            .collect();
-        field = smooth_field(cues, fg, &chosen, prior)?;
+        chosen.par_iter_mut().enumerate().for_each(|(k, c)| {
+            *c = match &bounds[k] {
+                Some(b) => choose_within(cues, k, b, &field[k]),
+                None => none,
+            };
+        });
+        smooth_field(cues, fg, &chosen, prior, &mut planes, &mut field)?;
     }
     let out: Vec<(Vector3<f64>, f32)> = (0..n)
         .into_par_iter()
@@ -117,6 +118,36 @@ pub fn disambiguate_with(cues: &Cues, fg: &[bool], prior: &Prior) -> Result<Esti
     })
 }
 
+/// What a pixel's candidates take from its polarization, fixed over the iterations: the
+/// AoLP's direction and the cosines of the zenith bounds its DoLP sets for each
+/// reflection type (cosines, so that choosing needs no trigonometry).
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    /// `cos α`, `sin α` of the AoLP `α`.
+    aolp: [f32; 2],
+    /// Cosine of the smallest diffuse zenith ([`crate::zenith::ZenithModels::diffuse_mixed`]).
+    diffuse: f32,
+    /// Cosines of the specular interval's ends `[θ₋, max(θ₊, θ₋)]`
+    /// ([`crate::zenith::ZenithModels::specular_mixed`]).
+    specular: [f32; 2],
+    /// Only specular candidates ([`Cues::surely_specular`]).
+    specular_only: bool,
+}
+
+impl Bounds {
+    fn of(cues: &Cues, k: usize) -> Self {
+        let dolp = f64::from(cues.dolp[k]).max(0.0);
+        let (lo, hi) = cues.models.specular(dolp);
+        let (sin, cos) = f64::from(cues.aolp[k]).sin_cos();
+        Self {
+            aolp: [cos as f32, sin as f32],
+            diffuse: cues.models.diffuse(dolp).cos() as f32,
+            specular: [lo.cos() as f32, hi.max(lo).cos() as f32],
+            specular_only: cues.surely_specular(k),
+        }
+    }
+}
+
 /// The candidate of pixel `k` closest to `reference` (largest `n · reference` minus the
 /// type's cost): `(normal, type, n · reference)`. Each candidate's zenith is the
 /// reference's zenith projected onto the zeniths its reflection type allows for the
@@ -126,87 +157,108 @@ pub fn choose(
     k: usize,
     reference: &Vector3<f64>,
 ) -> (Vector3<f64>, ReflectionType, f64) {
-    let f = cues.frame(k);
+    choose_within(cues, k, &Bounds::of(cues, k), reference)
+}
+
+/// [`choose`] with the pixel's [`Bounds`]. In the pixel frame `(x_ref, y_ref, −d)` with
+/// `u` the AoLP's direction and `v` the direction across it, the candidates are
+/// `−d cos θ ± u sin θ` (diffuse) and `−d cos θ ± v sin θ` (specular), `θ` the
+/// reference's zenith clamped to the type's bounds.
+fn choose_within(
+    cues: &Cues,
+    k: usize,
+    b: &Bounds,
+    reference: &Vector3<f64>,
+) -> (Vector3<f64>, ReflectionType, f64) {
     if !cues.valid[k] {
         return (*reference, ReflectionType::None, 1.0);
     }
-    let alpha = f64::from(cues.aolp[k]);
-    let dolp = f64::from(cues.dolp[k]);
-    let mut best = (*reference, ReflectionType::None, f64::NEG_INFINITY);
-    let mut consider = |n: Vector3<f64>, kind: ReflectionType, cost: f64| {
-        let score = n.dot(reference) - cost;
-        if score > best.2 {
-            best = (n, kind, score);
+    let f = cues.frame(k);
+    let [ca, sa] = b.aolp.map(f64::from);
+    let u = f.x_ref * ca + f.y_ref * sa;
+    let v = f.y_ref * ca - f.x_ref * sa;
+    // The reference's zenith cosine and its projections on u and v.
+    let (c, pu, pv) = (-f.d.dot(reference), u.dot(reference), v.dot(reference));
+    let sine = |cz: f64| (1.0 - cz * cz).max(0.0).sqrt();
+    let [s_lo, s_hi] = b.specular.map(f64::from);
+    let cs = c.clamp(s_lo.min(s_hi), s_lo);
+    let ss = sine(cs);
+    // (cos θ, sin θ, in-plane direction, score, type); `p` is `direction · reference`.
+    let mut best = (1.0, 0.0, v, f64::NEG_INFINITY, ReflectionType::None);
+    let mut consider = |cz: f64, sz: f64, dir: Vector3<f64>, p: f64, kind, cost: f64| {
+        let score = c * cz + p * sz - cost;
+        if score > best.3 {
+            best = (cz, sz, dir, score, kind);
         }
     };
-    let (_, ref_zenith) = f.angles(reference);
-    let zs = cues.models.specular_mixed(dolp, ref_zenith);
-    if cues.surely_specular(k) {
-        for az in [alpha + FRAC_PI_2, alpha - FRAC_PI_2] {
-            consider(f.normal(az, zs), ReflectionType::Specular, 0.0);
-        }
+    if b.specular_only {
+        consider(cs, ss, v, pv, ReflectionType::Specular, 0.0);
+        consider(cs, ss, -v, -pv, ReflectionType::Specular, 0.0);
     } else {
-        let zd = cues.models.diffuse_mixed(dolp, ref_zenith);
-        for az in [alpha, alpha + PI] {
-            consider(f.normal(az, zd), ReflectionType::Diffuse, 0.0);
-        }
-        for az in [alpha + FRAC_PI_2, alpha - FRAC_PI_2] {
-            consider(f.normal(az, zs), ReflectionType::Mixed, MIXED_PENALTY);
-        }
+        let cd = c.min(f64::from(b.diffuse));
+        let sd = sine(cd);
+        consider(cd, sd, u, pu, ReflectionType::Diffuse, 0.0);
+        consider(cd, sd, -u, -pu, ReflectionType::Diffuse, 0.0);
+        consider(cs, ss, v, pv, ReflectionType::Mixed, MIXED_PENALTY);
+        consider(cs, ss, -v, -pv, ReflectionType::Mixed, MIXED_PENALTY);
     }
-    let (n, kind, _) = best;
+    let (cz, sz, dir, _, kind) = best;
+    let n = -f.d * cz + dir * sz;
     (n, kind, n.dot(reference))
 }
 
-/// Confidence-weighted Gaussian average of the chosen normals plus the prior, normalised.
+/// The planes [`smooth_field`] blurs, allocated once for all iterations.
+struct FieldPlanes {
+    weighted: [Gray<f32>; 3],
+    blurred: [Gray<f32>; 3],
+}
+
+impl FieldPlanes {
+    fn new(w: usize, h: usize) -> Self {
+        Self {
+            weighted: std::array::from_fn(|_| Gray::new(w, h)),
+            blurred: std::array::from_fn(|_| Gray::new(w, h)),
+        }
+    }
+}
+
+/// Confidence-weighted Gaussian average of the chosen normals plus the prior, normalised,
+/// into `field`.
 fn smooth_field(
     cues: &Cues,
     fg: &[bool],
     chosen: &[(Vector3<f64>, ReflectionType, f64)],
     prior: &Prior,
-) -> Result<Vec<Vector3<f64>>, ShapeError> {
-    let (w, h) = (cues.width, cues.height);
-    let weight = |k: usize| {
-        if fg[k] {
-            0.05 + f64::from(cues.confidence[k])
-        } else {
-            0.0
-        }
-    };
-    let mut planes = Vec::with_capacity(3);
-    for c in 0..3 {
-        let src = Gray::from_vec(
-            w,
-            h,
-            (0..w * h)
-                .map(|k| (chosen[k].0[c] * weight(k)) as f32)
-                .collect(),
-        )
-        .expect("sized");
-        planes.push(blur(&src)?);
-    }
-    Ok((0..w * h)
+    planes: &mut FieldPlanes,
+    field: &mut [Vector3<f64>],
+) -> Result<(), ShapeError> {
+    let [x, y, z] = &mut planes.weighted;
+    (x.as_mut_slice(), y.as_mut_slice(), z.as_mut_slice())
         .into_par_iter()
-        .map(|k| {
-            if !fg[k] {
-                return Vector3::zeros();
-            }
-            let avg = Vector3::new(
-                f64::from(planes[0].as_slice()[k]),
-                f64::from(planes[1].as_slice()[k]),
-                f64::from(planes[2].as_slice()[k]),
-            );
+        .enumerate()
+        .for_each(|(k, (x, y, z))| {
+            let wt = if fg[k] {
+                0.05 + f64::from(cues.confidence[k])
+            } else {
+                0.0
+            };
+            let n = chosen[k].0 * wt;
+            (*x, *y, *z) = (n.x as f32, n.y as f32, n.z as f32);
+        });
+    for (src, dst) in planes.weighted.iter().zip(&mut planes.blurred) {
+        gaussian_blur(src, dst, 0, FIELD_SIGMA)?;
+    }
+    let [x, y, z] = planes.blurred.each_ref().map(|p| p.as_slice());
+    field.par_iter_mut().enumerate().for_each(|(k, out)| {
+        *out = if fg[k] {
+            let avg = Vector3::new(f64::from(x[k]), f64::from(y[k]), f64::from(z[k]));
             let v = avg + prior.normal[k] * (PRIOR_WEIGHT * prior.weight[k]);
             v.try_normalize(1e-12).unwrap_or(prior.normal[k])
-        })
-        .collect())
-}
-
-/// Gaussian blur with the field's sigma.
-fn blur(src: &Gray<f32>) -> Result<Gray<f32>, ShapeError> {
-    let mut dst = Gray::new(src.width(), src.height());
-    gaussian_blur(src, &mut dst, 0, FIELD_SIGMA)?;
-    Ok(dst)
+        } else {
+            Vector3::zeros()
+        };
+    });
+    Ok(())
 }
 
 /// The occluding-boundary prior of step 1 (module doc). It starts the iterations
@@ -244,14 +296,14 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
             let (dx, dy) = outward[k];
             let r = radius[k].max(1.0);
             let sin_z = (1.0 - (dist[k] - 0.5).max(0.0) / r).clamp(0.0, 1.0);
-            if dx.hypot(dy) < 1e-6 {
+            let Some(out) = image_direction(&f, dx, dy).filter(|_| dx.hypot(dy) >= 1e-6) else {
                 return (-f.d, 0.0);
-            }
-            let az = image_direction_angle(&f, dx, dy);
+            };
             // Unverified: the prior still starts the iterations, without weight in them.
             let verified = to_verified[k] <= dist[k] + VERIFIED_SLACK;
+            let cos_z = (1.0 - sin_z * sin_z).sqrt();
             (
-                f.normal(az, sin_z.asin()),
+                -f.d * cos_z + out * sin_z,
                 f64::from(u8::from(verified)) * sin_z * sin_z,
             )
         })
@@ -363,34 +415,52 @@ fn component_max(fg: &[bool], dist: &[f64], w: usize, h: usize) -> Result<Vec<f6
 /// background, infinite everywhere when there is no background pixel. Pixels outside
 /// the image are not background: a border cut is not an occluding contour.
 pub fn distance_to_background(fg: &[bool], w: usize, h: usize) -> Vec<f64> {
-    let inf = f64::INFINITY;
-    let mut d: Vec<f64> = fg.iter().map(|&f| if f { inf } else { 0.0 }).collect();
-    if d.iter().all(|v| v.is_infinite()) {
-        return d;
+    if fg.iter().all(|&f| f) {
+        return vec![f64::INFINITY; w * h];
     }
-    let mut buf = Vec::new();
-    for x in 0..w {
-        let col: Vec<f64> = (0..h).map(|y| d[y * w + x]).collect();
-        edt_1d(&col, &mut buf);
-        for y in 0..h {
-            d[y * w + x] = buf[y];
-        }
+    let inf_or_zero = |f: bool| if f { f64::INFINITY } else { 0.0 };
+    // Columns into a column-major buffer, then rows back into row-major order.
+    let mut cols = vec![0.0f64; w * h];
+    cols.par_chunks_mut(h)
+        .enumerate()
+        .for_each_init(Edt::default, |edt, (x, out)| {
+            edt.run((0..h).map(|y| inf_or_zero(fg[y * w + x])), out);
+        });
+    let mut d = vec![0.0f64; w * h];
+    d.par_chunks_mut(w)
+        .enumerate()
+        .for_each_init(Edt::default, |edt, (y, out)| {
+            edt.run((0..w).map(|x| cols[x * h + y]), out);
+            out.iter_mut().for_each(|v| *v = v.sqrt());
+        });
+    d
+}
+
+/// Scratch of [`edt_1d`], reused across the lines of one thread.
+#[derive(Default)]
+struct Edt {
+    f: Vec<f64>,
+    v: Vec<usize>,
+    z: Vec<f64>,
+}
+
+impl Edt {
+    /// The squared distance transform of the line `f` into `out`.
+    fn run(&mut self, f: impl Iterator<Item = f64>, out: &mut [f64]) {
+        self.f.clear();
+        self.f.extend(f);
+        edt_1d(&self.f, out, &mut self.v, &mut self.z);
     }
-    for y in 0..h {
-        let row = d[y * w..(y + 1) * w].to_vec();
-        edt_1d(&row, &mut buf);
-        d[y * w..(y + 1) * w].copy_from_slice(&buf);
-    }
-    d.iter().map(|v| v.sqrt()).collect()
 }
 
 /// 1-D squared distance transform of `f` (lower envelope of parabolas) into `out`.
-fn edt_1d(f: &[f64], out: &mut Vec<f64>) {
+fn edt_1d(f: &[f64], out: &mut [f64], v: &mut Vec<usize>, z: &mut Vec<f64>) {
     let n = f.len();
-    out.clear();
-    out.resize(n, f64::INFINITY);
-    let mut v = vec![0usize; n];
-    let mut z = vec![0.0f64; n + 1];
+    out.fill(f64::INFINITY);
+    v.clear();
+    v.resize(n, 0);
+    z.clear();
+    z.resize(n + 1, 0.0);
     let mut k = 0usize;
     let mut started = false;
     for q in 0..n {

@@ -152,6 +152,99 @@ fn dolp_at_model_maximum() {
     }));
 }
 
+/// `choose` against its definition, per pixel of a perspective frame with random DoLP and
+/// AoLP and for random references: the chosen normal has the zenith its type's model
+/// allows nearest the reference's (`diffuse_mixed` / `specular_mixed`), the AoLP's
+/// azimuth (diffuse) or the one across it (specular, mixed), and no other candidate
+/// scores higher. The normal matches its candidate to 1e-5: the pixel's zenith bounds are
+/// kept as `f32` cosines.
+#[test]
+fn choose_takes_the_nearest_candidate_its_models_allow() {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let (w, h) = (12, 10);
+    let mut seed = 7u64;
+    let mut rnd = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let data: Vec<f32> = (0..w * h)
+        .flat_map(|_| {
+            let (rho, a) = (rnd() * 0.6, rnd() * PI);
+            [1.0, rho * (2.0 * a).cos(), rho * (2.0 * a).sin()].map(|v| v as f32)
+        })
+        .collect();
+    let img = LinearStokesImage::from_vec(w, h, data).unwrap();
+    let camera = CameraModel::Pinhole { fov_x_deg: 50.0 };
+    let cues = Cues::new(
+        &Observation::new(StokesPlanes::from_linear_stokes(&img), camera),
+        1.5,
+    )
+    .unwrap();
+    let mut kinds = [0usize; 3];
+    for k in 0..w * h {
+        let f = cues.frame(k);
+        let (alpha, dolp) = (f64::from(cues.aolp[k]), f64::from(cues.dolp[k]));
+        for _ in 0..10 {
+            let r = f.normal(rnd() * 2.0 * PI, rnd() * 1.5);
+            let (n, kind, agree) = choose(&cues, k, &r);
+            let (_, rz) = f.angles(&r);
+            let (zd, zs) = (
+                cues.models.diffuse_mixed(dolp, rz),
+                cues.models.specular_mixed(dolp, rz),
+            );
+            let candidates = [
+                (alpha, zd, ReflectionType::Diffuse, 0.0),
+                (alpha + PI, zd, ReflectionType::Diffuse, 0.0),
+                (
+                    alpha + FRAC_PI_2,
+                    zs,
+                    ReflectionType::Mixed,
+                    crate::local::MIXED_PENALTY,
+                ),
+                (
+                    alpha - FRAC_PI_2,
+                    zs,
+                    ReflectionType::Mixed,
+                    crate::local::MIXED_PENALTY,
+                ),
+            ];
+            let allowed: Vec<_> = if cues.surely_specular(k) {
+                candidates[2..]
+                    .iter()
+                    .map(|c| (c.0, c.1, ReflectionType::Specular, 0.0))
+                    .collect()
+            } else {
+                candidates.to_vec()
+            };
+            let score =
+                |(az, z, _, cost): (f64, f64, ReflectionType, f64)| f.normal(az, z).dot(&r) - cost;
+            let best = allowed
+                .iter()
+                .map(|&c| score(c))
+                .fold(f64::NEG_INFINITY, f64::max);
+            let mine = allowed
+                .iter()
+                .find(|c| c.2 == kind && (f.normal(c.0, c.1) - n).norm() < 1e-5);
+            let mine =
+                mine.unwrap_or_else(|| panic!("pixel {k}: {n:?} ({kind:?}) is no candidate"));
+            assert!(
+                score(*mine) > best - 1e-9,
+                "pixel {k}: {kind:?} scores below the best"
+            );
+            assert!((agree - n.dot(&r)).abs() < 1e-9 && (n.norm() - 1.0).abs() < 1e-6);
+            kinds[match kind {
+                ReflectionType::Diffuse => 0,
+                ReflectionType::Specular => 1,
+                _ => 2,
+            }] += 1;
+        }
+    }
+    // Every branch was taken.
+    assert!(kinds.iter().all(|&c| c > 0), "{kinds:?}");
+}
+
 #[test]
 fn grazing_angles_at_occluding_contour() {
     let scene = sphere_scene(96, 1.5);
