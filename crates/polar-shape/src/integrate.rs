@@ -22,6 +22,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use nalgebra::Vector3;
 use polar_image::Gray;
+use rayon::prelude::*;
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex64;
 
@@ -89,66 +90,77 @@ pub fn finish(z: &[f64], fg: &[bool], w: usize, h: usize) -> Gray<f32> {
 }
 
 /// Frankot–Chellappa with the forward-difference symbol `e^{iω} − 1` and half-pixel
-/// averaged slopes (periodic).
+/// averaged slopes (periodic). The two real slope fields share one complex transform
+/// (`p + i q`), separated by the Hermitian symmetry of a real field's spectrum.
 pub fn frankot_chellappa(p: &[f64], q: &[f64], w: usize, h: usize) -> Vec<f64> {
-    let ph: Vec<Complex64> = (0..w * h)
+    let mut pq: Vec<Complex64> = (0..w * h)
+        .into_par_iter()
         .map(|k| {
             let (x, y) = (k % w, k / w);
-            Complex64::new(0.5 * (p[k] + p[y * w + (x + 1) % w]), 0.0)
-        })
-        .collect();
-    let qh: Vec<Complex64> = (0..w * h)
-        .map(|k| {
-            let (x, y) = (k % w, k / w);
-            Complex64::new(0.5 * (q[k] + q[((y + 1) % h) * w + x]), 0.0)
+            let pa = 0.5 * (p[k] + p[y * w + (x + 1) % w]);
+            let qa = 0.5 * (q[k] + q[((y + 1) % h) * w + x]);
+            Complex64::new(pa, qa)
         })
         .collect();
     let mut planner = FftPlanner::<f64>::new();
-    let (mut ph, mut qh) = (ph, qh);
-    fft2(&mut planner, &mut ph, w, h, false);
-    fft2(&mut planner, &mut qh, w, h, false);
-    let tau = std::f64::consts::TAU;
+    fft2(&mut planner, &mut pq, w, h, false);
+    // The difference symbols e^{iω} − 1 along each axis.
+    let symbol = |n: usize| -> Vec<Complex64> {
+        (0..n)
+            .map(|u| Complex64::from_polar(1.0, std::f64::consts::TAU * u as f64 / n as f64) - 1.0)
+            .collect()
+    };
+    let (sx, sy) = (symbol(w), symbol(h));
     let mut zh: Vec<Complex64> = (0..w * h)
+        .into_par_iter()
         .map(|k| {
             let (u, v) = (k % w, k / w);
-            let dx = Complex64::from_polar(1.0, tau * u as f64 / w as f64) - 1.0;
-            let dy = Complex64::from_polar(1.0, tau * v as f64 / h as f64) - 1.0;
+            let (dx, dy) = (sx[u], sy[v]);
             let den = dx.norm_sqr() + dy.norm_sqr();
             if den < 1e-12 {
-                Complex64::new(0.0, 0.0)
-            } else {
-                (dx.conj() * ph[k] + dy.conj() * qh[k]) / den
+                return Complex64::new(0.0, 0.0);
             }
+            // P(k) = (C(k) + C*(−k)) / 2, Q(k) = (C(k) − C*(−k)) / 2i.
+            let c = pq[k];
+            let m = pq[((h - v) % h) * w + (w - u) % w].conj();
+            let (ph, qh) = ((c + m) * 0.5, (c - m) * Complex64::new(0.0, -0.5));
+            (dx.conj() * ph + dy.conj() * qh) / den
         })
         .collect();
     fft2(&mut planner, &mut zh, w, h, true);
     let scale = 1.0 / (w * h) as f64;
-    zh.iter().map(|c| c.re * scale).collect()
+    zh.par_iter().map(|c| c.re * scale).collect()
 }
 
-/// In-place 2-D FFT (rows then columns), unnormalised.
+/// In-place 2-D FFT (rows, then columns through a transposed copy), unnormalised; the
+/// lines of each pass are transformed in parallel.
 fn fft2(planner: &mut FftPlanner<f64>, data: &mut [Complex64], w: usize, h: usize, inverse: bool) {
-    let row = if inverse {
-        planner.plan_fft_inverse(w)
-    } else {
-        planner.plan_fft_forward(w)
+    let lines = |planner: &mut FftPlanner<f64>, buf: &mut [Complex64], n: usize| {
+        let plan = if inverse {
+            planner.plan_fft_inverse(n)
+        } else {
+            planner.plan_fft_forward(n)
+        };
+        let zero = Complex64::new(0.0, 0.0);
+        let scratch = || vec![zero; plan.get_inplace_scratch_len()];
+        buf.par_chunks_mut(n)
+            .for_each_init(scratch, |s, line| plan.process_with_scratch(line, s));
     };
-    row.process(data);
-    let col = if inverse {
-        planner.plan_fft_inverse(h)
-    } else {
-        planner.plan_fft_forward(h)
-    };
-    let mut buf = vec![Complex64::new(0.0, 0.0); h];
-    for x in 0..w {
-        for y in 0..h {
-            buf[y] = data[y * w + x];
+    lines(planner, data, w);
+    let mut t = transpose(data, w, h);
+    lines(planner, &mut t, h);
+    data.copy_from_slice(&transpose(&t, h, w));
+}
+
+/// The `h × w` transpose of a row-major `w × h` array.
+fn transpose(src: &[Complex64], w: usize, h: usize) -> Vec<Complex64> {
+    let mut dst = vec![Complex64::new(0.0, 0.0); w * h];
+    dst.par_chunks_mut(h).enumerate().for_each(|(x, col)| {
+        for (y, d) in col.iter_mut().enumerate() {
+            *d = src[y * w + x];
         }
-        col.process(&mut buf);
-        for y in 0..h {
-            data[y * w + x] = buf[y];
-        }
-    }
+    });
+    dst
 }
 
 /// Weighted least-squares integration over the foreground (module doc).
