@@ -10,8 +10,9 @@
 //!   weight = polarization confidence. A π flip does not change the row, so this
 //!   constraint holds for both ambiguous normals;
 //! - shading (resolves the flip): Lambertian `s = b·n + a` with `n = (P, −Q, 1) cos θ`, θ
-//!   the zenith, gives `b_x P − b_y Q = (s − a)/cos θ − b_z`; the light `b` (times albedo)
-//!   and ambient `a` are fitted to the normalised brightness by least squares over
+//!   the zenith, gives `b_x P − b_y Q = (s − a)/cos θ − b_z` on the pixels the local
+//!   method calls diffuse (specular and mixed light is not Lambertian); the light `b`
+//!   (times albedo) and ambient `a` are fitted to the normalised brightness by least squares over
 //!   confidently lit, non-specular foreground pixels (two passes, the second without
 //!   residual outliers: shadows, highlights); the zenith comes from the local method;
 //! - a weak pull (weight 0.05) toward the local method's slopes, which keeps regions
@@ -83,7 +84,7 @@ pub fn solve(
                 if let Some((b, a)) = light {
                     let s = f64::from(cues.s0n[k]);
                     let lit = b.dot(&n) + a;
-                    let ok = local.reflection[k] != ReflectionType::Specular
+                    let ok = local.reflection[k] == ReflectionType::Diffuse
                         && s < HIGHLIGHT
                         && lit > 0.05
                         && n.z > 0.1;

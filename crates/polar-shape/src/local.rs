@@ -25,7 +25,10 @@
 //!    ([`Cues::surely_specular`]) only get specular candidates. Elsewhere a specular
 //!    candidate costs [`MIXED_PENALTY`]; when one still wins, the pixel is
 //!    [`ReflectionType::Mixed`] (specular azimuth in a DoLP the diffuse model also
-//!    explains).
+//!    explains). On an object whose rim is polarized across its outward normal
+//!    ([`Prior::specular_rim`]: specular reflection dominates its light, as on glossy
+//!    plastic under a bright sky or on metal) the diffuse candidates pay the penalty
+//!    instead.
 //! 4. Output: `normalize(c n + (1 − c) field)` with `c` the polarization confidence, so
 //!    pixels without measurable polarization take their neighbours' shape.
 //!
@@ -64,6 +67,8 @@ pub struct Prior {
     pub normal: Vec<Vector3<f64>>,
     /// Prior weight in `[0, 1]` (0 off the foreground or without any contour).
     pub weight: Vec<f64>,
+    /// The pixel's object is specular-dominated at its rim ([`specular_rims`]).
+    pub specular_rim: Vec<bool>,
 }
 
 /// Disambiguated normals of the foreground pixels.
@@ -76,7 +81,7 @@ pub fn disambiguate_with(cues: &Cues, fg: &[bool], prior: &Prior) -> Result<Esti
     let n = cues.len();
     let bounds: Vec<Option<Bounds>> = (0..n)
         .into_par_iter()
-        .map(|k| fg[k].then(|| Bounds::of(cues, k)))
+        .map(|k| fg[k].then(|| Bounds::of(cues, k, prior.specular_rim[k])))
         .collect();
     let none = (Vector3::zeros(), ReflectionType::None, 0.0);
     let mut chosen: Vec<_> = (0..n).into_par_iter().map(|_| none).collect();
@@ -132,10 +137,13 @@ struct Bounds {
     specular: [f32; 2],
     /// Only specular candidates ([`Cues::surely_specular`]).
     specular_only: bool,
+    /// The diffuse candidates, not the specular ones, pay [`MIXED_PENALTY`]
+    /// ([`Prior::specular_rim`]).
+    specular_rim: bool,
 }
 
 impl Bounds {
-    fn of(cues: &Cues, k: usize) -> Self {
+    fn of(cues: &Cues, k: usize, specular_rim: bool) -> Self {
         let dolp = f64::from(cues.dolp[k]).max(0.0);
         let (lo, hi) = cues.models.specular(dolp);
         let (sin, cos) = f64::from(cues.aolp[k]).sin_cos();
@@ -144,6 +152,7 @@ impl Bounds {
             diffuse: cues.models.diffuse(dolp).cos() as f32,
             specular: [lo.cos() as f32, hi.max(lo).cos() as f32],
             specular_only: cues.surely_specular(k),
+            specular_rim,
         }
     }
 }
@@ -157,7 +166,7 @@ pub fn choose(
     k: usize,
     reference: &Vector3<f64>,
 ) -> (Vector3<f64>, ReflectionType, f64) {
-    choose_within(cues, k, &Bounds::of(cues, k), reference)
+    choose_within(cues, k, &Bounds::of(cues, k, false), reference)
 }
 
 /// [`choose`] with the pixel's [`Bounds`]. In the pixel frame `(x_ref, y_ref, −d)` with
@@ -197,10 +206,15 @@ fn choose_within(
     } else {
         let cd = c.min(f64::from(b.diffuse));
         let sd = sine(cd);
-        consider(cd, sd, u, pu, ReflectionType::Diffuse, 0.0);
-        consider(cd, sd, -u, -pu, ReflectionType::Diffuse, 0.0);
-        consider(cs, ss, v, pv, ReflectionType::Mixed, MIXED_PENALTY);
-        consider(cs, ss, -v, -pv, ReflectionType::Mixed, MIXED_PENALTY);
+        let (diffuse_cost, specular_cost) = if b.specular_rim {
+            (MIXED_PENALTY, 0.0)
+        } else {
+            (0.0, MIXED_PENALTY)
+        };
+        consider(cd, sd, u, pu, ReflectionType::Diffuse, diffuse_cost);
+        consider(cd, sd, -u, -pu, ReflectionType::Diffuse, diffuse_cost);
+        consider(cs, ss, v, pv, ReflectionType::Mixed, specular_cost);
+        consider(cs, ss, -v, -pv, ReflectionType::Mixed, specular_cost);
     }
     let (cz, sz, dir, _, kind) = best;
     let n = -f.d * cz + dir * sz;
@@ -275,6 +289,7 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
         return Ok(Prior {
             normal,
             weight: vec![0.0; n],
+            specular_rim: vec![false; n],
         });
     }
     let radius = component_max(fg, &dist, w, h)?;
@@ -311,7 +326,38 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
     Ok(Prior {
         normal: out.iter().map(|v| v.0).collect(),
         weight: out.iter().map(|v| v.1).collect(),
+        specular_rim: specular_rims(cues, fg, &dist, &outward)?,
     })
+}
+
+/// `true` on the pixels of each 8-connected object whose polarization lies across its
+/// outward normal along its rim: the DoLP-weighted mean of `cos 2Δ` (Δ = AoLP − outward
+/// direction) over the band within [`CONTOUR_BAND`] pixels of the background is
+/// negative. At an occluding contour diffuse light leaves polarized along the normal
+/// (`cos 2Δ = +1`) and specular reflection across it (`−1`), so the sign says which of
+/// the two dominates the object's light (a glossy plastic under a bright sky, a metal).
+fn specular_rims(
+    cues: &Cues,
+    fg: &[bool],
+    dist: &[f64],
+    outward: &[(f64, f64)],
+) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let (id, n) = polar_imgproc::mask::components(fg, w, h)?;
+    let mut sums = vec![0.0f64; n + 1];
+    for k in (0..w * h).filter(|&k| fg[k] && cues.valid[k] && dist[k] <= CONTOUR_BAND) {
+        let (dx, dy) = outward[k];
+        if dx.hypot(dy) < 1e-6 {
+            continue;
+        }
+        let normal = image_direction_angle(&cues.frame(k), dx, dy);
+        let delta = f64::from(cues.aolp[k]) - normal;
+        sums[id[k] as usize] += f64::from(cues.dolp[k]) * (2.0 * delta).cos();
+    }
+    Ok(id
+        .iter()
+        .map(|&c| c != 0 && sums[c as usize] < 0.0)
+        .collect())
 }
 
 /// Background pixels next to the part of the foreground's boundary that shows the

@@ -515,6 +515,71 @@ fn specular_dominated_sphere_with_diffuse_range_dolp() {
     assert!(err < 10.0, "median angular error {err}");
 }
 
+/// Two spheres side by side, the left one's light specular (AoLP across the azimuth,
+/// diluted to a fifth of the specular DoLP as on glossy plastic), the right one's
+/// diffuse: the prior marks every pixel of the left sphere, and none of the right, as
+/// specular at its rim.
+#[test]
+fn specular_rim_marks_the_specular_object_only() {
+    let (left, right) = (Vector3::new(-1.3, 0.0, -6.0), Vector3::new(1.3, 0.0, -6.0));
+    let l = light();
+    let mut scene = Scene::render(128, 64, 40.0, 1.5, 0.05, |d| {
+        let lit = |n: Vector3<f64>| lambert(&n, &l, 0.5, 0.2);
+        sphere_hit(d, left, 1.0)
+            .map(|n| (n, Kind::Specular, lit(n)))
+            .or_else(|| sphere_hit(d, right, 1.0).map(|n| (n, Kind::Diffuse, lit(n))))
+    });
+    let on_left: Vec<bool> = (0..scene.width * scene.height)
+        .map(|k| scene.normals[k].norm_squared() > 0.0 && k % scene.width < scene.width / 2)
+        .collect();
+    for (s, &l) in scene.stokes.iter_mut().zip(&on_left) {
+        if l {
+            s[1] *= 0.2;
+            s[2] *= 0.2;
+        }
+    }
+    let obs = scene.observation(1.0);
+    let cues = Cues::new(&obs, 1.5).unwrap();
+    let fg: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    let prior = crate::local::boundary_prior(&cues, &fg).unwrap();
+    for k in (0..fg.len()).filter(|&k| fg[k]) {
+        assert_eq!(prior.specular_rim[k], on_left[k], "pixel {k}");
+    }
+}
+
+/// Where nothing else decides (a patch whose DoLP both models explain, a reference at a
+/// zenith both allow and halfway between the diffuse and the specular azimuth), the
+/// pixels read their AoLP as diffuse, or as specular (mixed) when their object is
+/// specular at its rim.
+#[test]
+fn specular_rim_decides_an_ambiguous_reading() {
+    let obs = uniform_observation(8, 8, [1.0, 0.01, 0.0], CameraModel::Orthographic);
+    let cues = Cues::new(&obs, 1.5).unwrap();
+    let fg = vec![true; 64];
+    for (rim, want) in [
+        (false, ReflectionType::Diffuse),
+        (true, ReflectionType::Mixed),
+    ] {
+        let (az, zenith) = (45f64.to_radians(), 40f64.to_radians());
+        let between = Vector3::new(
+            az.cos() * zenith.sin(),
+            az.sin() * zenith.sin(),
+            zenith.cos(),
+        );
+        let prior = crate::local::Prior {
+            normal: vec![between; 64],
+            weight: vec![0.0; 64],
+            specular_rim: vec![rim; 64],
+        };
+        let est = crate::local::disambiguate_with(&cues, &fg, &prior).unwrap();
+        assert!(est.reflection.iter().all(|&r| r == want), "rim {rim}");
+    }
+}
+
 /// A uniform number in `[0, 1)` from a pixel index and a salt (splitmix64).
 fn hash01(k: usize, salt: u64) -> f64 {
     let mut z = (k as u64).wrapping_add(salt.wrapping_mul(0x9E37_79B9_7F4A_7C15));
