@@ -72,6 +72,8 @@ use polar_imgproc::{
     threshold_otsu,
 };
 
+use rayon::prelude::*;
+
 use crate::ShapeError;
 use crate::cues::{Cues, image_direction_angle};
 
@@ -132,16 +134,19 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     let faces = object_faces(cues, enclosed_by_edges(cues)?, &coherent.regions)?;
     let enclosed = &faces.enclosed;
     let fg: Vec<bool> = (0..w * h)
+        .into_par_iter()
         .map(|k| {
             cues.valid[k]
                 && (coherent.regions[k] || (enclosed.regions[k] && !coherent.open_holes[k]))
         })
         .collect();
     let polarized: Vec<bool> = (0..w * h)
+        .into_par_iter()
         .map(|k| coherent.regions[k] || faces.polarized[k])
         .collect();
     let fg = open_see_through_holes(cues, fg, enclosed, &polarized)?;
     let evidence: Vec<bool> = (0..w * h)
+        .into_par_iter()
         .map(|k| coherent.regions[k] || enclosed.interiors[k])
         .collect();
     let fg = with_evidence(fg, &evidence, w, h)?;
@@ -403,8 +408,8 @@ fn looks_through(hole: Option<f32>, object: Option<f32>, background: Option<f32>
 /// The edge strength `g` of the module doc.
 pub fn edge_strength(cues: &Cues) -> Result<Gray<f32>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
-    let plane = |f: &dyn Fn(usize) -> f32| -> Gray<f32> {
-        Gray::from_vec(w, h, (0..w * h).map(f).collect()).expect("sized")
+    let plane = |f: &(dyn Fn(usize) -> f32 + Sync)| -> Gray<f32> {
+        Gray::from_vec(w, h, (0..w * h).into_par_iter().map(f).collect()).expect("sized")
     };
     let log_s = plane(&|k| (cues.s0n[k].max(0.0) + DARK_FLOOR).ln());
     let (c, s) = (
@@ -423,13 +428,14 @@ pub fn edge_strength(cues: &Cues) -> Result<Gray<f32>, ShapeError> {
             let mut d = Gray::new(w, h);
             sobel(&smooth, &mut d, dx, dy, 3)?;
             // A unit ramp gives a 3x3 Sobel response of 8.
-            for (acc, v) in g.iter_mut().zip(d.as_slice()) {
+            g.par_iter_mut().zip(d.as_slice()).for_each(|(acc, v)| {
                 let v = v / 8.0 * weight;
                 *acc += v * v;
-            }
+            });
         }
     }
-    Ok(Gray::from_vec(w, h, g.into_iter().map(f32::sqrt).collect()).expect("sized"))
+    g.par_iter_mut().for_each(|v| *v = v.sqrt());
+    Ok(Gray::from_vec(w, h, g).expect("sized"))
 }
 
 /// Pixels of the edge-free 4-connected regions that touch the image border: the
@@ -448,15 +454,19 @@ enum Morph {
 
 /// Applies `op` with a 3x3 square to a mask.
 fn morph_mask(mask: &[bool], w: usize, h: usize, op: Morph) -> Result<Vec<bool>, ShapeError> {
-    let src = Gray::from_vec(w, h, mask.iter().map(|&m| f32::from(u8::from(m))).collect())
-        .expect("sized");
+    let src = Gray::from_vec(
+        w,
+        h,
+        mask.par_iter().map(|&m| f32::from(u8::from(m))).collect(),
+    )
+    .expect("sized");
     let mut dst = Gray::new(w, h);
     match op {
         Morph::Dilate => dilate(&src, &mut dst, MorphShape::Rect, 3, 3)?,
         Morph::Erode => erode(&src, &mut dst, MorphShape::Rect, 3, 3)?,
         Morph::Open => open(&src, &mut dst, MorphShape::Rect, 3, 3)?,
     }
-    Ok(dst.as_slice().iter().map(|&v| v > 0.5).collect())
+    Ok(dst.as_slice().par_iter().map(|&v| v > 0.5).collect())
 }
 
 /// Cue B of the module doc (at least 3×3 pixels).
@@ -496,8 +506,8 @@ fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
 pub fn rayleigh_statistic(cues: &Cues) -> Result<Gray<f32>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let used = |k: usize| cues.valid[k] && cues.dolp[k] > 0.0;
-    let plane = |f: &dyn Fn(usize) -> f32| -> Gray<f32> {
-        Gray::from_vec(w, h, (0..w * h).map(f).collect()).expect("sized")
+    let plane = |f: &(dyn Fn(usize) -> f32 + Sync)| -> Gray<f32> {
+        Gray::from_vec(w, h, (0..w * h).into_par_iter().map(f).collect()).expect("sized")
     };
     let angle = |k: usize| 2.0 * cues.aolp[k];
     let cos = plane(&|k| if used(k) { angle(k).cos() } else { 0.0 });
