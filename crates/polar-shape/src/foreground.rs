@@ -125,6 +125,12 @@ const POLARIZED_INTERIOR: f64 = 0.3;
 /// and demosaicing residue), above which an interior is a polarized object face: a glossy
 /// or dark dielectric whose AoLP varies too fast for cue B (the real camera's body).
 const FACE_DOLP_FACTOR: f32 = 2.0;
+/// Lowest background DoLP [`FACE_DOLP_FACTOR`] multiplies: a camera's DoLP noise floor
+/// (photon noise at mid-scale of an IMX250MZR-class sensor, about 5000 e⁻ per pixel,
+/// gives DoLP noise near 1/√5000 ≈ 0.014). Against a noise-free render's near-zero
+/// background, light reflected onto the floor by the objects counted as polarized and
+/// made faces of the floor in a torus's hole.
+const MIN_BACKGROUND_DOLP: f32 = 0.01;
 
 /// Foreground mask (`true` on objects) of the cues (module doc).
 pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
@@ -193,15 +199,19 @@ pub(crate) fn enclosed_by_edges(cues: &Cues) -> Result<Enclosed, ShapeError> {
 }
 
 /// Cue A kept to its object faces ([`object_faces`]).
-struct Faces {
-    enclosed: Enclosed,
+pub(crate) struct Faces {
+    pub(crate) enclosed: Enclosed,
     /// Pixels of faces polarized above the background ([`FACE_DOLP_FACTOR`]).
-    polarized: Vec<bool>,
+    pub(crate) polarized: Vec<bool>,
 }
 
 /// Cue A restricted to its object faces (module doc, A.4) and to the edges that go with
 /// them ([`face_edges`]); all of A when B is empty.
-fn object_faces(cues: &Cues, enclosed: Enclosed, coherent: &[bool]) -> Result<Faces, ShapeError> {
+pub(crate) fn object_faces(
+    cues: &Cues,
+    enclosed: Enclosed,
+    coherent: &[bool],
+) -> Result<Faces, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     if !coherent.iter().any(|&v| v) {
         return Ok(Faces {
@@ -266,8 +276,8 @@ struct Verdict {
 
 /// Per interior label of `id` (`n` labels; index 0 outside them): it is an object face
 /// when at least [`HELD_BY_B`] of the pixels within [`RING_FAR`] steps around it are B,
-/// when its median DoLP is above [`FACE_DOLP_FACTOR`] times the background's (then it is
-/// also `polarized`), or when its rim (the interior grown by [`EDGE_BAND`] steps through
+/// when its median DoLP is above [`FACE_DOLP_FACTOR`] times the background's, taken as at
+/// least [`MIN_BACKGROUND_DOLP`] (then it is also `polarized`), or when its rim (the interior grown by [`EDGE_BAND`] steps through
 /// A) shows the occluding-contour signature at [`FACE_CONTOUR_SIGNIFICANCE`].
 fn face_interiors(
     cues: &Cues,
@@ -290,7 +300,8 @@ fn face_interiors(
             .filter(|&k| cues.valid[k] && !enclosed.regions[k] && !enclosed.interiors[k])
             .map(|k| cues.dolp[k])
             .collect(),
-    );
+    )
+    .map(|b| b.max(MIN_BACKGROUND_DOLP));
     let mut dolp: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
     for k in (0..w * h).filter(|&k| id[k] > 0 && cues.valid[k]) {
         dolp[id[k] as usize].push(cues.dolp[k]);
