@@ -260,7 +260,7 @@ fn normals_from_depth(
 }
 
 /// Normal equations `AᵀW A z = AᵀW b` of a sparse least-squares problem, accumulated row
-/// by row.
+/// by row (the lower triangle of `AᵀW A`: [`solve_spd`] reads no more).
 struct Normal {
     trips: Vec<Triplet<usize, usize, f64>>,
     rhs: Vec<f64>,
@@ -281,7 +281,7 @@ impl Normal {
         }
         for &(i, ci) in row {
             self.rhs[i] += wt * ci * b;
-            for &(j, cj) in row {
+            for &(j, cj) in row.iter().filter(|&&(j, _)| j <= i) {
                 self.trips.push(Triplet::new(i, j, wt * ci * cj));
             }
         }

@@ -185,7 +185,7 @@ pub fn poisson(
         return Ok(z);
     }
     let weight = |k: usize| 0.05 + f64::from(confidence[k]).clamp(0.0, 1.0);
-    let mut trips = Vec::with_capacity(5 * count);
+    let mut trips = Vec::with_capacity(4 * count);
     let mut rhs = vec![0.0; count];
     for i in 0..count {
         trips.push(Triplet::new(i, i, 1e-6));
@@ -196,8 +196,7 @@ pub fn poisson(
         // Row: z_b − z_a = slope, weight wt.
         trips.push(Triplet::new(i, i, wt));
         trips.push(Triplet::new(j, j, wt));
-        trips.push(Triplet::new(i, j, -wt));
-        trips.push(Triplet::new(j, i, -wt));
+        trips.push(Triplet::new(i.max(j), i.min(j), -wt));
         rhs[j] += wt * slope;
         rhs[i] -= wt * slope;
     };
@@ -224,7 +223,8 @@ pub fn poisson(
     Ok(z)
 }
 
-/// Solves the symmetric positive definite system given by (summed) triplets.
+/// Solves the symmetric positive definite system given by the (summed) triplets of its
+/// lower triangle (row ≥ column; the Cholesky factorisation reads no other).
 pub fn solve_spd(
     n: usize,
     trips: &[Triplet<usize, usize, f64>],
