@@ -24,6 +24,7 @@ import numpy as np
 import skimage
 from skimage.filters import threshold_otsu
 from skimage.measure import label as sk_label
+from skimage.morphology import convex_hull_object
 from skimage.metrics import peak_signal_noise_ratio, structural_similarity
 
 GOLDEN = Path(__file__).resolve().parent.parent / "crates/polar-imgproc/tests/golden"
@@ -169,6 +170,16 @@ def components(wr, rng):
                 {"labels": lab_sauf.astype(np.int32), "stats": stats.astype(np.int32),
                  "centroids": cent.astype(np.float64), "labels_default": lab_def.astype(np.int32)},
                 {"n": int(n) - 1})
+    # Convex hulls: the blobs above, and open outlines (arcs, a diagonal line, single pixels)
+    # whose hulls are large next to their pixels.
+    outlines = np.zeros((H, W), np.uint8)
+    cv2.ellipse(outlines, (16, 14), (11, 8), 20, 30, 300, 255, 1)
+    cv2.ellipse(outlines, (45, 30), (9, 12), -35, 200, 470, 255, 1)
+    cv2.line(outlines, (3, 44), (30, 33), 255, 1)
+    outlines[2, 60] = outlines[46, 62] = outlines[40, 2] = 255
+    for name, src in [("mask", mask), ("outlines", outlines)]:
+        hull = convex_hull_object(src > 0, connectivity=2).astype(np.uint8)
+        wr.case(f"convex_hull_{name}", "convex_hull_objects", {}, {"src": (name, src)}, {"hull": hull})
 
 
 def metrics(wr, rng, img, degraded):

@@ -149,6 +149,113 @@ pub fn remove_small(m: &[bool], w: usize, h: usize, min_area: usize) -> Result<V
         .collect())
 }
 
+/// Union of the convex hulls of the 8-connected components of `m`: scikit-image's
+/// `convex_hull_object(connectivity=2)`. A component's hull is taken over the midpoints of
+/// its pixels' edges, and a pixel belongs to it when its centre lies inside or on the hull;
+/// the arithmetic is exact (coordinates doubled to integers).
+pub fn convex_hull_objects(m: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
+    let (lab, n) = components(m, w, h)?;
+    // Per component and row, the leftmost and rightmost pixel: the hull's only candidates.
+    let mut extremes: Vec<Vec<(usize, usize, usize)>> = vec![Vec::new(); n + 1];
+    for y in 0..h {
+        let row = &lab[y * w..(y + 1) * w];
+        for (x, &l) in row.iter().enumerate() {
+            if l == 0 {
+                continue;
+            }
+            match extremes[l as usize].last_mut() {
+                Some((ey, _, right)) if *ey == y => *right = x,
+                _ => extremes[l as usize].push((y, x, x)),
+            }
+        }
+    }
+    let mut out = vec![false; w * h];
+    for rows in &extremes[1..] {
+        let hull = hull_of_edge_midpoints(rows);
+        for (y, lo, hi) in hull_rows(&hull, w) {
+            out[y * w + lo..=y * w + hi].fill(true);
+        }
+    }
+    Ok(out)
+}
+
+/// Convex hull (Andrew's monotone chain, counter-clockwise, collinear points dropped) of
+/// the edge midpoints of the pixels `(y, left..=right)`, in doubled coordinates `(2x, 2y)`.
+fn hull_of_edge_midpoints(rows: &[(usize, usize, usize)]) -> Vec<(i64, i64)> {
+    let mut pts: Vec<(i64, i64)> = Vec::with_capacity(rows.len() * 8);
+    for &(y, left, right) in rows {
+        let y = 2 * y as i64;
+        for x in [2 * left as i64, 2 * right as i64] {
+            pts.extend([(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)]);
+        }
+    }
+    pts.sort_unstable();
+    pts.dedup();
+    let cross = |o: (i64, i64), a: (i64, i64), b: (i64, i64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(i64, i64)> = Vec::with_capacity(pts.len() + 1);
+    for pass in [
+        pts.as_slice(),
+        &pts.iter().rev().copied().collect::<Vec<_>>(),
+    ] {
+        let start = hull.len();
+        for &p in pass {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// The pixel runs `(y, first x, last x)` whose centres `(2x, 2y)` lie inside or on the
+/// convex polygon `hull` (doubled coordinates), clipped to the image width `w`.
+fn hull_rows(hull: &[(i64, i64)], w: usize) -> Vec<(usize, usize, usize)> {
+    let (y0, y1) = hull
+        .iter()
+        .fold((i64::MAX, i64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let mut runs = Vec::new();
+    // Centre rows 2y with y0 <= 2y <= y1.
+    for y in (y0 + 1).div_euclid(2).max(0)..=y1.div_euclid(2) {
+        let yy = 2 * y;
+        let (mut lo, mut hi) = (i64::MAX, i64::MIN);
+        for (i, &a) in hull.iter().enumerate() {
+            let b = hull[(i + 1) % hull.len()];
+            if yy < a.1.min(b.1) || yy > a.1.max(b.1) {
+                continue;
+            }
+            if a.1 == b.1 {
+                lo = lo.min(ceil_div(a.0.min(b.0), 2));
+                hi = hi.max((a.0.max(b.0)).div_euclid(2));
+                continue;
+            }
+            // Crossing at x = a.0 + (yy − a.1)(b.0 − a.0)/(b.1 − a.1); pixel x when 2x on it.
+            let (num, den) = (
+                a.0 * (b.1 - a.1) + (yy - a.1) * (b.0 - a.0),
+                2 * (b.1 - a.1),
+            );
+            let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
+            lo = lo.min(ceil_div(num, den));
+            hi = hi.max(num.div_euclid(den));
+        }
+        let hi = hi.min(w as i64 - 1);
+        if lo.max(0) <= hi {
+            runs.push((y as usize, lo.max(0) as usize, hi as usize));
+        }
+    }
+    runs
+}
+
+/// `⌈a / b⌉` for `b > 0`.
+fn ceil_div(a: i64, b: i64) -> i64 {
+    -(-a).div_euclid(b)
+}
+
 /// Structuring-element diameter: about 1/40 of the image's smaller side, odd, at least 3.
 pub fn morph_size(w: usize, h: usize) -> usize {
     ((w.min(h) / 40) | 1).max(3)
@@ -179,6 +286,43 @@ mod tests {
         let f = fill_holes(&m, w, h).unwrap();
         assert!(f[3 * w + 3] && f[2 * w + 2]);
         assert!(!f[0] && !f[3 * w]);
+    }
+
+    #[test]
+    fn hull_keeps_single_pixels_and_empty_masks() {
+        assert_eq!(
+            convex_hull_objects(&[false; 6], 3, 2).unwrap(),
+            vec![false; 6]
+        );
+        let mut m = vec![false; 12];
+        m[0] = true;
+        m[11] = true;
+        assert_eq!(convex_hull_objects(&m, 4, 3).unwrap(), m);
+        assert_eq!(convex_hull_objects(&[true], 1, 1).unwrap(), vec![true]);
+    }
+
+    /// An open arc (a C) is closed into its convex disc; two separate arcs keep their own
+    /// hulls, not one across the gap between them.
+    #[test]
+    fn hull_closes_an_open_arc_per_component() {
+        let (w, h) = (40, 20);
+        let mut m = vec![false; w * h];
+        for t in 0..300 {
+            let a = (f64::from(t) / 300.0) * 1.6 * std::f64::consts::PI + 0.3;
+            for cx in [9.0, 29.0] {
+                let (x, y) = (cx + 7.0 * a.cos(), 9.5 + 7.0 * a.sin());
+                m[y.round() as usize * w + x.round() as usize] = true;
+            }
+        }
+        let hull = convex_hull_objects(&m, w, h).unwrap();
+        for cx in [9, 29] {
+            assert!(
+                hull[9 * w + cx] && hull[9 * w + cx + 6],
+                "centre and the open side"
+            );
+        }
+        assert!(!hull[9 * w + 19], "nothing between the two arcs");
+        assert!(!hull[0] && !hull[w - 1]);
     }
 
     /// The run-distance closing-opening equals the grey-scale one exactly, on

@@ -308,6 +308,29 @@ fn labels_equal_skimage_label() {
     }
 }
 
+/// Exact: both take the hull of the pixels' edge midpoints and keep the pixel centres
+/// inside or on it, and every coordinate is a half-integer.
+#[test]
+fn convex_hulls_equal_skimage_convex_hull_object() {
+    let g = Golden::load();
+    let cases = g.cases("convex_hull_objects");
+    assert_eq!(cases.len(), 2);
+    for case in cases {
+        let src = g.gray_u8(&g.input(case, "src"));
+        let (w, h) = (src.width(), src.height());
+        let m: Vec<bool> = src.as_slice().iter().map(|&v| v != 0).collect();
+        let got = polar_imgproc::mask::convex_hull_objects(&m, w, h).unwrap();
+        let want = g.gray_u8(&g.output(case, "hull"));
+        let differ = got
+            .iter()
+            .zip(want.as_slice())
+            .filter(|(a, b)| **a != (**b != 0))
+            .count();
+        assert_eq!(differ, 0, "{}: {differ} pixels differ", case["name"]);
+        assert!(got.iter().filter(|&&b| b).count() > m.iter().filter(|&&b| b).count());
+    }
+}
+
 #[test]
 fn stats_equal_cv2_connected_components_with_stats() {
     let g = Golden::load();

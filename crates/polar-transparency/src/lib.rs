@@ -10,7 +10,11 @@
 //! DoLP: sensor noise and demosaicing artefacts at texture edges have random AoLP and
 //! average out) and the polarization-difference contrast; it then thresholds the score
 //! (Otsu, or a given threshold), closes and opens the mask, fills holes (background
-//! components not touching the border) and drops specks, all with polar-imgproc.
+//! components not touching the border), drops specks and replaces each component by its
+//! convex hull, all with polar-imgproc. The hull is there because glass is polarized
+//! mostly along its rims and edges (reflection and transmission both grow toward
+//! grazing) and little where it faces the camera, so the seeds are open arcs around
+//! the object; glass objects (balls, slabs, cups, bottles) are mostly convex.
 //!
 //! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass.
 //! The cue that separates them is transmission: see [`cues`] for what is measured.
@@ -119,6 +123,11 @@ pub const MIN_THRESHOLD: f32 = 0.3;
 /// against their share of real frames (about one in eight in the training suite).
 pub const KNN_THRESHOLD: f32 = 0.7;
 
+/// A component of the cleaned mask must cover this many averaging windows
+/// ([`cues::WINDOW`]²): fewer hold too few independent polarization samples to be told
+/// from a noise speck, and the convex hull would spread the speck.
+pub const MIN_WINDOWS: usize = 4;
+
 /// The result of [`detect`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct TransparencyMap {
@@ -159,6 +168,8 @@ pub fn detect(
     };
     let seed: Vec<bool> = score.as_slice().iter().map(|&s| s > t).collect();
     let m = polar_imgproc::mask::clean(&seed, w, h)?;
+    let m = polar_imgproc::mask::remove_small(&m, w, h, MIN_WINDOWS * cues::WINDOW.pow(2))?;
+    let m = polar_imgproc::mask::convex_hull_objects(&m, w, h)?;
     let mask = Gray::from_vec(w, h, m.iter().map(|&b| if b { ON } else { 0 }).collect())
         .expect("size of the observation");
     Ok(TransparencyMap { mask, score })

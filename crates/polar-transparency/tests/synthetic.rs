@@ -11,7 +11,8 @@ use polar_learn::{Expect, KnnModel, LearnError};
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::{Observation, StokesPlanes};
 use polar_transparency::knn::{self, BUILTIN_MODEL, EXPECT, KnnClassifier};
-use polar_transparency::{ON, Segmenter, TransparencyOptions, detect};
+use polar_transparency::{MIN_WINDOWS, ON, Segmenter, TransparencyOptions, detect};
+use std::f64::consts::FRAC_PI_2;
 
 const N: usize = 96;
 
@@ -98,6 +99,46 @@ fn glass_disc_over_checkerboard_is_found() {
     assert!(out.score.as_slice().iter().all(|s| (0.0..=1.0).contains(s)));
 }
 
+/// Glass lit so that only part of its rim is polarized: reflection of a bright window on
+/// one side, the rest of the disc transmitting the depolarized checkerboard at DoLP 0.
+/// The seed is an open arc (a C) that hole filling cannot close; the convex hull does, up
+/// to the chord across the unpolarized third of the rim: the circular segment beyond it
+/// (a fifth of the disc) is lost, so the IoU is at most 0.8. The arc alone: about 0.35.
+#[test]
+fn glass_polarized_along_an_open_arc_is_filled() {
+    let obs = observation(|x, y| match disc(x, y) {
+        Some((ze, az)) if ze > 0.7 && az.cos() > -0.5 => (
+            0.9 * checker(x, y),
+            2.0 * transmitted_dolp(ze, 1.5),
+            az + FRAC_PI_2,
+        ),
+        Some(_) => (0.9 * checker(x, y), 0.0, 0.0),
+        None => (checker(x, y), 0.0, 0.0),
+    });
+    let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
+    let iou = iou_with_disc(&out.mask);
+    assert!(iou > 0.7, "IoU {iou}");
+}
+
+/// Coherently polarized specks smaller than [`MIN_WINDOWS`] averaging windows are noise,
+/// not glass: dropped, and not spread by the hull.
+#[test]
+fn polarized_specks_are_no_glass() {
+    let obs = observation(|x, y| {
+        let speck = (x % 32) < 5 && (y % 32) < 5 && x > 8 && y > 8;
+        (checker(x, y), if speck { 0.4 } else { 0.0 }, 0.3)
+    });
+    // A 5x5 speck, spread by the window, stays under the minimum area.
+    let window = polar_transparency::cues::WINDOW;
+    assert!((5 + window - 1).pow(2) < MIN_WINDOWS * window.pow(2));
+    let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
+    assert!(out.mask.as_slice().iter().all(|&v| v == 0));
+    assert!(
+        out.score.as_slice().iter().any(|&s| s > 0.5),
+        "the specks do score"
+    );
+}
+
 /// A textured, depolarizing scene has no transparent object: the floored Otsu threshold
 /// must not split its noise-free score in two.
 #[test]
@@ -151,7 +192,9 @@ fn explicit_threshold_is_used_and_checked() {
         },
     )
     .unwrap();
-    assert!(iou_with_disc(&low.mask) > 0.85);
+    // Every pixel whose window reaches the disc (2 px beyond its rim), and the convex hull
+    // of that digitised disc a little more: IoU about 0.84.
+    assert!(iou_with_disc(&low.mask) > 0.8);
     assert!(none.mask.as_slice().iter().all(|&v| v == 0));
     for bad in [-0.1, 1.5, f32::NAN] {
         assert!(
