@@ -223,7 +223,7 @@ pub fn add_training_pixels(
     classes: &mut Vec<u8>,
 ) -> Result<(), MaterialError> {
     crate::check_size("labels", obs.size(), Some(labels.size()))?;
-    let p = crate::prepare(obs, None, None, None)?;
+    let p = crate::prepare(obs, None, None)?;
     let x = FrameFeatures::new(&p)?;
     for (k, &l) in labels.as_slice().iter().enumerate() {
         if p.fg[k] && p.features.valid[k] && (l == DIELECTRIC || l == METAL) {

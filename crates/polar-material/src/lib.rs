@@ -60,7 +60,7 @@ pub enum MaterialError {
 pub struct Prepared {
     /// Per-pixel polarization features.
     pub features: features::Features,
-    /// `true` on object pixels (opaque: transparent pixels are cleared).
+    /// `true` on object pixels.
     pub fg: Vec<bool>,
     /// The 8-connected regions of `fg`.
     pub regions: Regions,
@@ -128,7 +128,10 @@ pub struct MaterialMap {
 /// from the object silhouettes (the kNN always takes them from the silhouettes, as it was
 /// trained). `foreground`: non-zero on object pixels; without it
 /// [`foreground::estimate`] decides. `transparent`: non-zero on transparent pixels, which
-/// are labelled [`TRANSPARENT`] and left out of the opaque classes.
+/// are labelled [`TRANSPARENT`] over the opaque classification. They stay in the object
+/// regions it classifies: the edge of a transparency mask is no occluding contour, and
+/// cutting an opaque object along a mistaken one would give its remaining pixels a false
+/// silhouette and a smaller region vote.
 pub fn classify(
     obs: &Observation,
     normals: Option<&NormalImage>,
@@ -141,7 +144,8 @@ pub fn classify(
         Classifier::Physics => normals,
         Classifier::Knn(_) => None,
     };
-    let p = prepare(obs, normals, foreground, transparent)?;
+    check_size("transparent", obs.size(), transparent.map(|m| m.size()))?;
+    let p = prepare(obs, normals, foreground)?;
     let smooth = opts.smooth_regions;
     let metal = match clf {
         Classifier::Physics => rule::metal_probability(&p, smooth)?,
@@ -171,28 +175,20 @@ pub fn classify(
     })
 }
 
-/// Features, object pixels (`foreground`, else [`foreground::estimate`], minus
-/// `transparent`), their regions and cues (from `normals`, else from the silhouettes) of
-/// `obs`.
+/// Features, object pixels (`foreground`, else [`foreground::estimate`]), their regions
+/// and cues (from `normals`, else from the silhouettes) of `obs`.
 pub fn prepare(
     obs: &Observation,
     normals: Option<&NormalImage>,
     foreground: Option<&Gray<u8>>,
-    transparent: Option<&Gray<u8>>,
 ) -> Result<Prepared, MaterialError> {
     let size = obs.size();
     check_size("foreground", size, foreground.map(|m| m.size()))?;
-    check_size("transparent", size, transparent.map(|m| m.size()))?;
     let features = features::Features::new(obs)?;
-    let mut fg = match foreground {
+    let fg = match foreground {
         Some(m) => m.as_slice().iter().map(|&v| v != 0).collect(),
         None => foreground::estimate(&features)?,
     };
-    if let Some(t) = transparent {
-        for (v, &t) in fg.iter_mut().zip(t.as_slice()) {
-            *v &= t == 0;
-        }
-    }
     let regions = Regions::new(&fg, size.0, size.1)?;
     let cues = match normals {
         Some(n) => cues::from_normals(obs, &features, n)?,

@@ -43,7 +43,7 @@ fn scaled(obs: &Observation, factor: f32) -> Observation {
 fn features_are_scale_invariant_times_7() {
     let (obs, _, _) = scene([Surface::Specular(1.5, 0.0), Surface::Diffuse(1.4)]);
     let features = |o: &Observation| {
-        let p = prepare(o, None, None, None).unwrap();
+        let p = prepare(o, None, None).unwrap();
         (knn::pixel_features(&p).unwrap(), p.fg)
     };
     let (a, fa) = features(&obs);

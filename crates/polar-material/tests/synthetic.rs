@@ -106,6 +106,41 @@ fn transparent_mask_wins() {
     assert_eq!(out.labels.as_slice()[0], BACKGROUND);
 }
 
+/// A transparency mask that cuts into an opaque object (a false positive of the
+/// transparency task over the left half of the diffuse sphere) relabels those pixels and
+/// changes nothing else: its edge is no occluding contour, so the rest of the sphere keeps
+/// its silhouette and its region vote, label and confidence alike.
+#[test]
+fn transparent_mask_only_relabels() {
+    let (obs, _, fg) = scene([Surface::Diffuse(1.5), Surface::Specular(1.0, 6.6)]);
+    let mut t = Gray::<u8>::new(W, H);
+    for y in 0..H {
+        for x in 0..24 {
+            t.as_mut_slice()[y * W + x] = 255;
+        }
+    }
+    let opts = MaterialOptions::default();
+    let with = classify(&obs, None, Some(&fg), Some(&t), &Classifier::Physics, &opts).unwrap();
+    let without = classify(&obs, None, Some(&fg), None, &Classifier::Physics, &opts).unwrap();
+    assert!(share(&without.labels, 0, DIELECTRIC) > 0.95);
+    for k in 0..W * H {
+        if t.as_slice()[k] != 0 {
+            assert_eq!(with.labels.as_slice()[k], TRANSPARENT);
+        } else {
+            assert_eq!(
+                with.labels.as_slice()[k],
+                without.labels.as_slice()[k],
+                "pixel {k}"
+            );
+            assert_eq!(
+                with.confidence.as_slice()[k],
+                without.confidence.as_slice()[k],
+                "pixel {k}"
+            );
+        }
+    }
+}
+
 fn uniform(w: usize, h: usize, s0: f32, s1: f32) -> Observation {
     let mut p = StokesPlanes::new(w, h);
     p.s0.as_mut_slice().fill(s0);
