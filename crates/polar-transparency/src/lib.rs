@@ -1,4 +1,4 @@
-//! Transparent-object detection from polarization, without training.
+//! Transparent-object detection from polarization.
 //!
 //! Glass polarizes every ray it returns: light reflected off its surfaces is polarized
 //! across the plane of incidence (strongly near Brewster's angle), light transmitted
@@ -8,7 +8,7 @@
 //! background of none. [`detect`] scores each pixel by cue maps ([`cues`]): the DoLP of
 //! the locally averaged Stokes vector, its coherence (that DoLP over the mean per-pixel
 //! DoLP: sensor noise and demosaicing artefacts at texture edges have random AoLP and
-//! average out) and the polarization-difference contrast; it then thresholds the score
+//! average out); it then thresholds the score
 //! (Otsu, or a given threshold), closes and opens the mask, fills holes (background
 //! components not touching the border), drops specks and replaces each component by its
 //! convex hull, all with polar-imgproc. The hull is there because glass is polarized
@@ -16,8 +16,10 @@
 //! grazing) and little where it faces the camera, so the seeds are open arcs around
 //! the object; glass objects (balls, slabs, cups, bottles) are mostly convex.
 //!
-//! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass.
-//! The cue that separates them is transmission: see [`cues`] for what is measured.
+//! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass, and
+//! neither segmenter tells them apart reliably (docs/benchmarks.md measures the false
+//! positives on them; the kNN adds the polarization-difference contrast, the AoLP spread
+//! and intensity edges to the cues, [`knn::FEATURES`]).
 //!
 //! [`detect`] runs one of two segmenters ([`Segmenter`]): the cue score above, which needs
 //! no training, or a k-nearest-neighbour classifier over per-pixel features built on the
