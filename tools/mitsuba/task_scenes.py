@@ -9,7 +9,7 @@ shares our renderer's BSDF models, light models and scene recipes, so a
 method can fit our renderer's quirks and still look good on our own data.
 These scenes close that loop a little: Mitsuba's own BSDFs (`pplastic`,
 `conductor` / `roughconductor` with Mitsuba's spectral material names Au, Ag,
-Al, Cu, `dielectric` / `roughdielectric`, `diffuse`), Mitsuba's own lights
+Al, Cu, `dielectric`, `diffuse`), Mitsuba's own lights
 (`constant` environment, `directional` sun, `sphere` area lights) and
 camera (`perspective`, fov_axis x), and scene layouts written here from
 scratch (deliberately not our datagen's recipes). The generalization gap is
@@ -25,9 +25,15 @@ family (the folder name without its trailing -digits) is `mts-<kind>-<noise>`:
                     on a floor under an environment plus a sun or a sphere light
   material  3       Mitsuba conductors (Au, Ag, Al, Cu; smooth and rough) next
                     to pplastic and diffuse objects
-  glass     3       dielectric / roughdielectric spheres, a slab and an ellipsoid
+  glass     3       dielectric spheres, a slab and an ellipsoid
                     in front of a checkerboard backdrop, plus a shiny opaque
                     distractor (pplastic or silver)
+  glasshard 4       the hard cases of transparency, one per scene: glass in
+                    front of an opaque object, glass seen against glass, thin
+                    walls (a drinking glass, a blown bulb), glass in front of
+                    a plain wall. Frosted glass is not among them: Mitsuba's
+                    roughdielectric returns unpolarized light (DoLP 0 over
+                    it), so our datagen's rough glass stands for it
   haze      2       opaque objects at increasing distance in a homogeneous
                     medium with the project's polarized Rayleigh phase
                     function (rayleigh_phase.py) in `volpath`, sun from the side
@@ -155,6 +161,37 @@ def torus_mesh(major, minor, nu=128, nv=48):
     return centre + minor * n, n, faces
 
 
+def revolved(profile, nu=128):
+    """Surface of revolution about the y axis of a profile polyline [(r, y, nr, ny), ...],
+    traversed so that its outward normal (nr, ny) is the tangent turned by +90 degrees."""
+    prof = np.asarray(profile, float)
+    ph = np.linspace(0.0, 2 * np.pi, nu, endpoint=False)
+    c, s = np.cos(ph)[None, :], np.sin(ph)[None, :]
+    r, y, nr, ny = (prof[:, k, None] for k in range(4))
+    p = np.stack([r * c, y + 0 * c, r * s], -1).reshape(-1, 3)
+    n = np.stack([nr * c, ny + 0 * c, nr * s], -1).reshape(-1, 3)
+    return p, n, grid_faces(len(prof), nu, wrap_rows=False)
+
+
+def cup_mesh(radius, wall, height, base):
+    """A closed thin-walled cup standing on y = 0: outer wall, bottom, inner bottom,
+    inner wall and rim, each its own strip (sharp edges keep their normals)."""
+    ri = radius - wall
+    strips = [
+        [(radius, height, 1, 0), (radius, 0.0, 1, 0)],
+        [(radius, 0.0, 0, -1), (0.0, 0.0, 0, -1)],
+        [(0.0, base, 0, 1), (ri, base, 0, 1)],
+        [(ri, base, -1, 0), (ri, height, -1, 0)],
+        [(ri, height, 0, 1), (radius, height, 0, 1)],
+    ]
+    ps, ns, fs, offset = [], [], [], 0
+    for strip in strips:
+        p, n, f = revolved(strip)
+        ps.append(p), ns.append(n), fs.append(f + offset)
+        offset += len(p)
+    return np.vstack(ps), np.vstack(ns), np.vstack(fs)
+
+
 def write_ply(path, positions, normals, faces):
     """Binary little-endian PLY with vertex positions, normals and triangles."""
     header = (
@@ -236,10 +273,9 @@ def metal(name, alpha=None):
     return {"type": "roughconductor", "material": name, "alpha": alpha, "distribution": "ggx"}
 
 
-def glass(ior=1.5, alpha=None):
-    if alpha is None:
-        return {"type": "dielectric", "int_ior": ior, "ext_ior": 1.0}
-    return {"type": "roughdielectric", "int_ior": ior, "ext_ior": 1.0, "alpha": alpha, "distribution": "ggx"}
+def glass(ior=1.5, outside=1.0):
+    """A smooth glass interface; `outside` is the index on the side the normals face."""
+    return {"type": "dielectric", "int_ior": ior, "ext_ior": outside}
 
 
 def sun(toward, irradiance):
@@ -370,10 +406,11 @@ def glass_scenes(mi, m):
             "background": {"floor": floor(mi), "wall": backdrop(mi, -1.5, 8.0, 5.0, 0.0, board)},
             "emitters": {"sky": {"type": "constant", "radiance": 0.6}, "sun": sun([-0.6, 1.0, 0.8], 2.5)},
         },
-        {  # frosted ball, glass ellipsoid and a glossy plastic cube
+        {  # a glass ball, a glass ellipsoid and a glossy plastic cube (the ball is smooth:
+           # Mitsuba's roughdielectric returns unpolarized light, which no glass does)
             "camera": ([-0.4, 1.6, 5.2], [0.0, 0.6, 0.0], 38.0),
             "objects": {
-                "frosted": (sphere([-1.1, 0.55, 0.2], 0.55, glass(1.45, 0.08)), LABEL_TRANSPARENT),
+                "ball": (sphere([-1.1, 0.55, 0.2], 0.55, glass(1.45)), LABEL_TRANSPARENT),
                 "drop": (mesh(mi, m, "ell-b", lambda: ellipsoid_mesh(0.35, 0.7, 0.35), glass(1.5),
                               [0.2, 0.7, 0.5], rotate=[([0, 0, 1], -15)]), LABEL_TRANSPARENT),
                 "cube": (mesh(mi, m, "rcube", lambda: rounded_cube_mesh(0.55), pplastic(0.2, 0.03),
@@ -383,6 +420,57 @@ def glass_scenes(mi, m):
                            "wall": backdrop(mi, -1.8, 9.0, 5.0, 0.0, checker_bsdf(mi, 0.15, 0.6, 9.0))},
             "emitters": {"sky": {"type": "constant", "radiance": 0.5},
                          "lamp": sphere_light([2.0, 3.5, 3.0], 0.5, 30.0)},
+        },
+    ]
+
+
+def glass_hard_scenes(mi, m):
+    """The hard cases of transparent-object detection, one per scene."""
+    board = checker_bsdf(mi, 0.1, 0.75, 12.0)
+    sky_sun = {"sky": {"type": "constant", "radiance": 0.6}, "sun": sun([0.4, 1.0, 0.9], 2.5)}
+    return [
+        {  # glass in front of an opaque object: a ball half over a glossy plastic sphere
+            "camera": ([0.0, 1.3, 5.0], [0.0, 0.6, 0.0], 34.0),
+            "objects": {
+                "ball": (sphere([-0.2, 0.55, 0.8], 0.55, glass(1.5)), LABEL_TRANSPARENT),
+                "behind": (sphere([0.45, 0.6, -0.5], 0.6, pplastic(0.45, 0.05)), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi), "wall": backdrop(mi, -1.6, 8.0, 5.0, 0.0, board)},
+            "emitters": sky_sun,
+        },
+        {  # glass seen against glass: two balls and an ellipsoid overlapping in the view
+            "camera": ([0.6, 1.4, 5.0], [0.0, 0.6, 0.0], 34.0),
+            "objects": {
+                "front": (sphere([-0.3, 0.45, 0.9], 0.45, glass(1.5)), LABEL_TRANSPARENT),
+                "back": (sphere([0.3, 0.6, -0.2], 0.6, glass(1.52)), LABEL_TRANSPARENT),
+                "drop": (mesh(mi, m, "ell-b", lambda: ellipsoid_mesh(0.35, 0.7, 0.35), glass(1.5),
+                              [-0.9, 0.7, -0.6]), LABEL_TRANSPARENT),
+            },
+            "background": {"floor": floor(mi), "wall": backdrop(mi, -1.8, 8.0, 5.0, 0.0, board)},
+            "emitters": sky_sun,
+        },
+        {  # thin walls: a drinking glass (1.5 cm wall) and a blown bulb (1 cm shell)
+            "camera": ([0.0, 1.8, 4.8], [0.0, 0.55, 0.0], 34.0),
+            "objects": {
+                "cup": (mesh(mi, m, "cup", lambda: cup_mesh(0.4, 0.015, 1.0, 0.04), glass(1.5),
+                             [-0.6, 0.0, 0.2]), LABEL_TRANSPARENT),
+                "bulb": (sphere([0.75, 0.5, 0.0], 0.5, glass(1.5)), LABEL_TRANSPARENT),
+                "bulb-inside": (sphere([0.75, 0.5, 0.0], 0.49, glass(1.0, outside=1.5)), LABEL_TRANSPARENT),
+            },
+            "background": {"floor": floor(mi), "wall": backdrop(mi, -1.5, 8.0, 5.0, 0.0, board)},
+            "emitters": sky_sun,
+        },
+        {  # a ball and a pane in front of a plain wall (no texture seen through the glass)
+            "camera": ([0.0, 1.3, 5.0], [0.0, 0.6, 0.0], 34.0),
+            "objects": {
+                "ball": (sphere([-0.6, 0.6, 0.3], 0.6, glass(1.5)), LABEL_TRANSPARENT),
+                "pane": ({"type": "cube", "bsdf": glass(1.52),
+                          "to_world": T(mi).translate([0.8, 0.7, -0.1]) @ T(mi).rotate([0, 1, 0], -25)
+                          @ T(mi).scale([0.45, 0.7, 0.05])}, LABEL_TRANSPARENT),
+            },
+            "background": {"floor": floor(mi),
+                           "wall": backdrop(mi, -1.6, 8.0, 5.0, 0.0, {"type": "diffuse", "reflectance": 0.55})},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.5}, "lamp": sphere_light([2.0, 3.5, 3.0], 0.5, 30.0)},
         },
     ]
 
@@ -425,7 +513,8 @@ def haze_scenes(mi, m):
     ]
 
 
-KINDS = {"shape": shape_scenes, "material": material_scenes, "glass": glass_scenes, "haze": haze_scenes}
+KINDS = {"shape": shape_scenes, "material": material_scenes, "glass": glass_scenes, "haze": haze_scenes,
+         "glasshard": glass_hard_scenes}
 
 
 # --------------------------------------------------------------------------- building and rendering

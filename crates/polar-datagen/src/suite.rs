@@ -383,7 +383,7 @@ const TRANSPARENT: &[ParamSpec] = &[
         "thickness",
         [0.05, 0.4],
         [0.005, 2.0],
-        "slab thickness / shell thickness, m",
+        "slab thickness, m (the other glass shapes are solid)",
     ),
     p(
         "texture_scale",
