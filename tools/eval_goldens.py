@@ -45,6 +45,7 @@ def material_case(pred, truth):
     np.add.at(cm, (truth.ravel(), pred.ravel()), 1)
     iou = [cm[c, c] / (cm[c].sum() + cm[:, c].sum() - cm[c, c]) for c in range(4)]
     return {"metal_vs_dielectric_accuracy": np.mean(pred[fg] == truth[fg]),
+            "opaque_coverage": fg.sum() / np.isin(truth, [1, 2]).sum(),
             "pixel_accuracy": np.mean(pred == truth), "class_iou": iou,
             "confusion": cm.tolist()}
 

@@ -101,6 +101,9 @@ pub struct MaterialMetrics {
     pub foreground_pixels: u64,
     /// Metal against dielectric: the fraction of those pixels labelled correctly.
     pub metal_vs_dielectric_accuracy: Option<f64>,
+    /// Those pixels over all pixels whose true label is 1 or 2: the share of the opaque
+    /// objects the accuracy speaks for (background or transparent predictions leave it).
+    pub opaque_coverage: Option<f64>,
     /// Fraction of all pixels labelled correctly (four classes).
     pub pixel_accuracy: Option<f64>,
     /// IoU per class (index = label), `None` where the class is in neither image.
@@ -119,9 +122,14 @@ pub fn material_metrics(pred: &Gray<u8>, truth: &Gray<u8>) -> Result<MaterialMet
             let c = cm.count(t, p);
             (r + if t == p { c } else { 0 }, n + c)
         });
+    let opaque: u64 = (1..=2)
+        .flat_map(|t| (0..4).map(move |p| (t, p)))
+        .map(|(t, p)| cm.count(t, p))
+        .sum();
     Ok(MaterialMetrics {
         foreground_pixels: fg,
         metal_vs_dielectric_accuracy: (fg > 0).then(|| right as f64 / fg as f64),
+        opaque_coverage: (opaque > 0).then(|| fg as f64 / opaque as f64),
         pixel_accuracy: cm.accuracy(),
         class_iou: (0..4).map(|c| cm.class_iou(c)).collect(),
         confusion: (0..4)
@@ -332,6 +340,8 @@ mod tests {
         // Foreground pairs: (1,1) right, (1,2) wrong, (2,2) right; (2,0) is not counted.
         assert_eq!(m.foreground_pixels, 3);
         assert!((m.metal_vs_dielectric_accuracy.unwrap() - 2.0 / 3.0).abs() < 1e-12);
+        // Four pixels are truly metal or dielectric; three of them are labelled so.
+        assert!((m.opaque_coverage.unwrap() - 3.0 / 4.0).abs() < 1e-12);
         assert_eq!(m.confusion[2][0], 1);
         assert_eq!(m.class_iou[3], Some(1.0));
         assert!(material_metrics(&gray(3, vec![0u8, 1, 4]), &gray(3, vec![0u8; 3])).is_err());

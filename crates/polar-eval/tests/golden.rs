@@ -113,6 +113,12 @@ fn material_metrics_match_numpy() {
         "fg accuracy",
     );
     assert_rel(
+        m.opaque_coverage.unwrap(),
+        g.expected("material.opaque_coverage"),
+        1e-12,
+        "opaque coverage",
+    );
+    assert_rel(
         m.pixel_accuracy.unwrap(),
         g.expected("material.pixel_accuracy"),
         1e-12,

@@ -300,7 +300,7 @@ fn write_report(
 }
 
 /// The headline figures of each task, in the order a reader looks for them.
-const HEADLINES: [(&str, &str, &str); 13] = [
+const HEADLINES: [(&str, &str, &str); 14] = [
     ("sfp", "normal.mean_deg", "mean angular error (deg)"),
     (
         "sfp",
@@ -313,6 +313,11 @@ const HEADLINES: [(&str, &str, &str); 13] = [
         "material",
         "metal_vs_dielectric_accuracy",
         "metal vs dielectric accuracy",
+    ),
+    (
+        "material",
+        "opaque_coverage",
+        "share of opaque object pixels labelled metal or dielectric",
     ),
     ("transparent", "iou", "mask IoU"),
     (
