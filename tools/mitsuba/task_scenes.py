@@ -184,12 +184,10 @@ def cup_mesh(radius, wall, height, base):
         [(ri, base, -1, 0), (ri, height, -1, 0)],
         [(ri, height, 0, 1), (radius, height, 0, 1)],
     ]
-    ps, ns, fs, offset = [], [], [], 0
-    for strip in strips:
-        p, n, f = revolved(strip)
-        ps.append(p), ns.append(n), fs.append(f + offset)
-        offset += len(p)
-    return np.vstack(ps), np.vstack(ns), np.vstack(fs)
+    parts = [revolved(strip) for strip in strips]
+    offsets = np.cumsum([0] + [len(p) for p, _, _ in parts[:-1]])
+    return (np.vstack([p for p, _, _ in parts]), np.vstack([n for _, n, _ in parts]),
+            np.vstack([f + o for (_, _, f), o in zip(parts, offsets)]))
 
 
 def write_ply(path, positions, normals, faces):

@@ -122,10 +122,7 @@ pub fn material_metrics(pred: &Gray<u8>, truth: &Gray<u8>) -> Result<MaterialMet
             let c = cm.count(t, p);
             (r + if t == p { c } else { 0 }, n + c)
         });
-    let opaque: u64 = (1..=2)
-        .flat_map(|t| (0..4).map(move |p| (t, p)))
-        .map(|(t, p)| cm.count(t, p))
-        .sum();
+    let opaque: u64 = (0..4).map(|p| cm.count(1, p) + cm.count(2, p)).sum();
     Ok(MaterialMetrics {
         foreground_pixels: fg,
         metal_vs_dielectric_accuracy: (fg > 0).then(|| right as f64 / fg as f64),
