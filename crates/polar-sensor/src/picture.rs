@@ -26,17 +26,30 @@ pub fn aolp_hsv(aolp: &Gray<f32>, dolp: &Gray<f32>) -> Rgb8 {
 
 /// [`aolp_hsv`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder).
 pub fn aolp_hsv_into(aolp: &[f32], dolp: &[f32], out: &mut [[u8; 3]]) {
-    out.par_iter_mut()
-        .zip(aolp)
-        .zip(dolp)
-        .for_each(|((px, &a), &d)| {
-            *px = if a.is_finite() && d.is_finite() {
-                let hue = (angle_mod_pi(a) / std::f32::consts::PI * 179.0) as u8;
-                let value = (d.clamp(0.0, 1.0) * 255.0) as u8;
-                full_saturation_table()[usize::from(hue) * 256 + usize::from(value)]
-            } else {
-                [0; 3]
-            };
+    assert!(aolp.len() == out.len() && dolp.len() == out.len());
+    let table = full_saturation_table();
+    fill_parallel(out, |k| {
+        let (a, d) = (aolp[k], dolp[k]);
+        if a.is_finite() && d.is_finite() {
+            let hue = (angle_mod_pi(a) / std::f32::consts::PI * 179.0) as u8;
+            let value = (d.clamp(0.0, 1.0) * 255.0) as u8;
+            table[usize::from(hue) * 256 + usize::from(value)]
+        } else {
+            [0; 3]
+        }
+    });
+}
+
+/// `out[k] = pixel(k)` for every `k`, in parallel blocks of plain loops (a per-pixel
+/// parallel iterator calls `pixel` through a reference, one call per pixel).
+fn fill_parallel(out: &mut [[u8; 3]], pixel: impl Fn(usize) -> [u8; 3] + Sync) {
+    const BLOCK: usize = 4096;
+    out.par_chunks_mut(BLOCK)
+        .enumerate()
+        .for_each(|(b, block)| {
+            for (j, px) in block.iter_mut().enumerate() {
+                *px = pixel(b * BLOCK + j);
+            }
         });
 }
 
@@ -104,11 +117,16 @@ const VIRIDIS: [[f32; 3]; 9] = [
 ];
 
 /// Colour of `t` in `[0, 1]` (clamped) on the viridis-like map.
+///
+/// Rounded as `trunc(x + 0.5)`: equal to `round(x)` for `0.5 <= x < 2^22` (the addition is
+/// exact there) and every channel is at least 1, but without a libm call per channel.
 pub fn viridis(t: f32) -> [u8; 3] {
     let u = t.clamp(0.0, 1.0) * (VIRIDIS.len() - 1) as f32;
-    let i = (u.floor() as usize).min(VIRIDIS.len() - 2);
+    let i = (u as usize).min(VIRIDIS.len() - 2);
     let f = u - i as f32;
-    std::array::from_fn(|c| (VIRIDIS[i][c] + f * (VIRIDIS[i + 1][c] - VIRIDIS[i][c])).round() as u8)
+    let [lo, hi] = [VIRIDIS[i], VIRIDIS[i + 1]];
+    let channel = |c: usize| (lo[c] + f * (hi[c] - lo[c]) + 0.5) as u8;
+    [channel(0), channel(1), channel(2)]
 }
 
 /// `values` mapped linearly from `[vmin, vmax]` onto the colour map; NaN gives black.
@@ -125,12 +143,14 @@ pub fn colormap_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [[u8; 3]]) 
     } else {
         0.0
     };
-    out.par_iter_mut().zip(values).for_each(|(px, &v)| {
-        *px = if v.is_finite() {
+    assert_eq!(values.len(), out.len());
+    fill_parallel(out, |k| {
+        let v = values[k];
+        if v.is_finite() {
             viridis((v - vmin) * scale)
         } else {
             [0; 3]
-        };
+        }
     });
 }
 
@@ -147,13 +167,14 @@ pub fn srgb_into(rgb: [&[f32]; 3], vmax: f32, out: &mut [[u8; 3]]) {
         };
         (e * 255.0).round() as u8
     };
-    out.par_iter_mut().enumerate().for_each(|(k, px)| {
-        let v = rgb.map(|c| c[k]);
-        *px = if v.iter().all(|c| !c.is_nan()) {
-            v.map(encode)
+    assert!(rgb.iter().all(|c| c.len() == out.len()));
+    fill_parallel(out, |k| {
+        let v = [rgb[0][k], rgb[1][k], rgb[2][k]];
+        if v.iter().all(|c| !c.is_nan()) {
+            [encode(v[0]), encode(v[1]), encode(v[2])]
         } else {
             [0; 3]
-        };
+        }
     });
 }
 
@@ -217,6 +238,24 @@ mod tests {
         let mut out = [[9; 3]; 4];
         srgb_into([&r, &g, &b], 2.0, &mut out);
         assert_eq!(out, [[0, 137, 188], [255, 255, 0], [188, 7, 0], [0, 0, 0]]);
+    }
+
+    #[test]
+    fn viridis_rounds_like_round_everywhere() {
+        let reference = |t: f32| {
+            let u = t.clamp(0.0, 1.0) * 8.0;
+            let i = (u.floor() as usize).min(7);
+            let f = u - i as f32;
+            std::array::from_fn::<u8, 3, _>(|c| {
+                (VIRIDIS[i][c] + f * (VIRIDIS[i + 1][c] - VIRIDIS[i][c])).round() as u8
+            })
+        };
+        // Every f32 in [0, 1] would take minutes; every 64th bit pattern covers all
+        // sub-intervals and rounding boundaries at this map's 8-bit resolution.
+        for bits in (0..=1.0f32.to_bits()).step_by(64) {
+            let t = f32::from_bits(bits);
+            assert_eq!(viridis(t), reference(t), "t {t}");
+        }
     }
 
     #[test]

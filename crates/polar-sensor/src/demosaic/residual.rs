@@ -79,7 +79,13 @@ fn roles(raw: impl Fn(isize, isize) -> f32, res: impl Fn(isize, isize) -> f32, g
         let (sp, sm) = (spread((dx, dy)), spread((-dx, -dy)));
         (res(dx, dy) * sm + res(-dx, -dy) * sp) / (sp + sm)
     };
-    let s = DIAGONALS.map(spread);
+    // Written out: `array::map` is not always inlined, and a call stops vectorisation.
+    let s = [
+        spread(DIAGONALS[0]),
+        spread(DIAGONALS[1]),
+        spread(DIAGONALS[2]),
+        spread(DIAGONALS[3]),
+    ];
     let others = [
         s[1] * s[2] * s[3],
         s[0] * s[2] * s[3],
@@ -158,8 +164,14 @@ pub(crate) fn guide_and_residual<T: MosaicSample>(
     let guide_rows = guide.as_mut_slice().par_chunks_mut(w);
     guide_rows.enumerate().for_each(|(y, row)| {
         let rows = [mirror(y as isize - 1, h), y, mirror(y as isize + 1, h)].map(|r| raw.row(r));
-        for (x, g) in row.iter_mut().enumerate() {
-            *g = guide_at(|dx, dy| f(rows[(dy + 1) as usize][mirror(x as isize + dx, w)]));
+        for x in [0, w - 1] {
+            row[x] = guide_at(|dx, dy| f(rows[(dy + 1) as usize][mirror(x as isize + dx, w)]));
+        }
+        // Interior: `cut[dy + 1][dx + 1][i]` is the mosaic at (1 + i + dx, y + dy).
+        let n = w - 2;
+        let cut: [[&[T]; 3]; 3] = rows.map(|r| std::array::from_fn(|k| &r[k..k + n]));
+        for (i, g) in row[1..w - 1].iter_mut().enumerate() {
+            *g = guide_at(|dx, dy| f(cut[(dy + 1) as usize][(dx + 1) as usize][i]));
         }
     });
     let gains = pair_gains(guide.view(), raw);
@@ -191,31 +203,34 @@ fn pair_gains<T: MosaicSample>(guide: ImageView<'_, f32, 1>, raw: ImageView<'_, 
     let (w, h) = raw.size();
     let top = (0..h)
         .into_par_iter()
-        .map(|y| raw.row(y).iter().map(|&v| f(v)).fold(0.0, f32::max))
-        .reduce(|| 0.0, f32::max);
+        .map(|y| raw.row(y).iter().map(|&v| v.into()).max().unwrap_or(0))
+        .max()
+        .unwrap_or(0);
     let (even, odd) = (2..h.saturating_sub(2))
         .into_par_iter()
-        .map(|y| {
-            let near: [&[T]; 5] = std::array::from_fn(|k| raw.row(y + k - 2));
-            let clipped = |x: usize| {
-                (-2..=2isize).any(|dy| {
-                    (-2..=2isize).any(|dx| {
-                        dx * dx + dy * dy < 8
-                            && f(near[(dy + 2) as usize][x.wrapping_add_signed(dx)]) >= top
-                    })
-                })
-            };
-            let [up, mid, down] = [y - 1, y, y + 1].map(|r| guide.row(r));
-            let (mut e, mut o) = (0.0f64, 0.0f64);
-            for x in (2 + (y & 1)..w.saturating_sub(2)).step_by(2) {
-                if clipped(x) {
-                    continue;
+        .map_init(
+            || (vec![false; w], vec![false; w]),
+            |(tall, short), y| {
+                // A sample at the frame's maximum within the 5x5 disc without its corners
+                // (dx² + dy² < 8): |dy| <= 2 in columns x - 1 ..= x + 1, |dy| <= 1 in x ± 2.
+                let near: [&[T]; 5] = std::array::from_fn(|k| raw.row(y + k - 2));
+                for (x, (t, s)) in tall.iter_mut().zip(short.iter_mut()).enumerate() {
+                    let at_top = |k: usize| near[k][x].into() >= top;
+                    *s = at_top(1) | at_top(2) | at_top(3);
+                    *t = *s | at_top(0) | at_top(4);
                 }
-                e += f64::from(mid[x]);
-                o += 0.25 * f64::from(mid[x - 1] + mid[x + 1] + up[x] + down[x]);
-            }
-            (e, o)
-        })
+                let [up, mid, down] = [y - 1, y, y + 1].map(|r| guide.row(r));
+                let (mut e, mut o) = (0.0f64, 0.0f64);
+                for x in (2 + (y & 1)..w.saturating_sub(2)).step_by(2) {
+                    if tall[x - 1] | tall[x] | tall[x + 1] | short[x - 2] | short[x + 2] {
+                        continue;
+                    }
+                    e += f64::from(mid[x]);
+                    o += 0.25 * f64::from(mid[x - 1] + mid[x + 1] + up[x] + down[x]);
+                }
+                (e, o)
+            },
+        )
         .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
     if even > 0.0 && odd > 0.0 {
         let g = (odd / even).sqrt();
