@@ -189,7 +189,7 @@ def main():
         f"| {'polanalyser demosaic+calcStokes+DoLP+AoLP (f64)':<52} | {'pip wheel':<22} | {t_py * 1e3:8.1f} | "
         f"{'1.0x':>14} | {t_py / first['bound_s']:7.1f}x |"
     )
-    for name in ["bilinear", "superpixel", "newton"]:
+    for name in ["bilinear", "residual", "superpixel", "newton"]:
         for label, rs in results.items():
             if name not in rs["seconds"]:
                 continue
