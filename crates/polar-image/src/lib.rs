@@ -6,6 +6,7 @@
 
 mod border;
 pub mod kind;
+mod par;
 mod quantile;
 mod view;
 
@@ -13,6 +14,7 @@ use std::marker::PhantomData;
 
 pub use border::Border;
 pub use kind::Plain;
+pub use par::{PAR_BLOCK, par_fill, par_map};
 pub use quantile::quantile;
 use thiserror::Error;
 pub use view::ImageView;

@@ -9,12 +9,12 @@
 //! phase is measured in a band along the mask boundary, against the outward direction
 //! of the blurred mask's gradient.
 
-use polar_image::{Gray, NormalImage};
+use polar_image::{Gray, NormalImage, par_map};
 use polar_imgproc::gaussian_blur;
 use polar_sensor::Observation;
 
 use crate::features::Features;
-use crate::{CHUNK, MaterialError, Regions, par_map};
+use crate::{CHUNK, MaterialError, Regions};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 

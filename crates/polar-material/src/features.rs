@@ -4,13 +4,12 @@
 //! over a small window of valid pixels before DoLP and AoLP are formed: averaging `S1, S2`
 //! first removes most of the upward bias that sensor noise gives a per-pixel DoLP.
 
-use polar_image::Gray;
-use polar_image::quantile;
+use polar_image::{Gray, par_fill, par_map, quantile};
 use polar_imgproc::{Border, box_filter};
 use polar_sensor::Observation;
 use rayon::prelude::*;
 
-use crate::{CHUNK, MaterialError, par_fill, par_map};
+use crate::{CHUNK, MaterialError};
 
 /// Side of the averaging window (pixels, odd).
 pub const WINDOW: usize = 5;

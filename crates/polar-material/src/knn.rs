@@ -5,7 +5,7 @@
 //! computed with the silhouette cues (the same at training and inference: the zenith is
 //! the sphere prior and the phase is measured against the silhouette's outward normal).
 
-use polar_image::Gray;
+use polar_image::{Gray, par_map};
 use polar_imgproc::{Border, box_filter};
 use polar_learn::{Expect, Knn};
 use polar_sensor::Observation;
@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use crate::features::Features;
 use crate::fresnel_cues::FresnelTable;
-use crate::{DIELECTRIC, METAL, MaterialError, Prepared, Regions, par_map};
+use crate::{DIELECTRIC, METAL, MaterialError, Prepared, Regions};
 
 /// The task name in model files.
 pub const TASK: &str = "material";

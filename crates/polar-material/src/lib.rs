@@ -203,22 +203,7 @@ pub fn prepare(
 }
 
 /// Pixels per rayon task in the element-wise passes (large enough to amortise a task).
-pub(crate) const CHUNK: usize = 1 << 14;
-
-/// `f(k)` for every pixel index `k < n`, computed in parallel, in index order (the same
-/// values whatever the thread count).
-pub(crate) fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    (0..n).into_par_iter().with_min_len(CHUNK).map(f).collect()
-}
-
-/// Sets `dst[k] = f(k)` for every index, in parallel (the same values whatever the thread
-/// count); for scratch planes reused across passes.
-pub(crate) fn par_fill<T: Send>(dst: &mut [T], f: impl Fn(usize) -> T + Sync + Send) {
-    dst.par_iter_mut()
-        .enumerate()
-        .with_min_len(CHUNK)
-        .for_each(|(k, d)| *d = f(k));
-}
+pub(crate) const CHUNK: usize = polar_image::PAR_BLOCK;
 
 fn check_size(
     what: &'static str,

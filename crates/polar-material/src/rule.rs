@@ -16,8 +16,8 @@
 use crate::cues::Cues;
 use crate::features::Features;
 use crate::fresnel_cues::FresnelTable;
-use crate::{MaterialError, Prepared, Regions, par_map};
-use polar_image::Gray;
+use crate::{MaterialError, Prepared, Regions};
+use polar_image::{Gray, par_map};
 use polar_imgproc::{Border, box_filter};
 
 /// DoLP margin above the metal envelope before the Fresnel cue fires (rendering or

@@ -8,8 +8,7 @@
 //!
 //! Undefined pixels (NaN) are black.
 
-use polar_image::{Gray, Image};
-use rayon::prelude::*;
+use polar_image::{Gray, Image, par_fill};
 
 /// An 8-bit RGB picture.
 pub type Rgb8 = Image<u8, 3>;
@@ -28,7 +27,7 @@ pub fn aolp_hsv(aolp: &Gray<f32>, dolp: &Gray<f32>) -> Rgb8 {
 pub fn aolp_hsv_into(aolp: &[f32], dolp: &[f32], out: &mut [[u8; 3]]) {
     assert!(aolp.len() == out.len() && dolp.len() == out.len());
     let table = full_saturation_table();
-    fill_parallel(out, |k| {
+    par_fill(out, |k| {
         let (a, d) = (aolp[k], dolp[k]);
         if a.is_finite() && d.is_finite() {
             let hue = (angle_mod_pi(a) / std::f32::consts::PI * 179.0) as u8;
@@ -38,19 +37,6 @@ pub fn aolp_hsv_into(aolp: &[f32], dolp: &[f32], out: &mut [[u8; 3]]) {
             [0; 3]
         }
     });
-}
-
-/// `out[k] = pixel(k)` for every `k`, in parallel blocks of plain loops (a per-pixel
-/// parallel iterator calls `pixel` through a reference, one call per pixel).
-fn fill_parallel(out: &mut [[u8; 3]], pixel: impl Fn(usize) -> [u8; 3] + Sync) {
-    const BLOCK: usize = 4096;
-    out.par_chunks_mut(BLOCK)
-        .enumerate()
-        .for_each(|(b, block)| {
-            for (j, px) in block.iter_mut().enumerate() {
-                *px = pixel(b * BLOCK + j);
-            }
-        });
 }
 
 /// `a.rem_euclid(π)`, without the division inside the AoLP range `(-π, π)` (where it is
@@ -144,7 +130,7 @@ pub fn colormap_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [[u8; 3]]) 
         0.0
     };
     assert_eq!(values.len(), out.len());
-    fill_parallel(out, |k| {
+    par_fill(out, |k| {
         let v = values[k];
         if v.is_finite() {
             viridis((v - vmin) * scale)
@@ -168,7 +154,7 @@ pub fn srgb_into(rgb: [&[f32]; 3], vmax: f32, out: &mut [[u8; 3]]) {
         (e * 255.0).round() as u8
     };
     assert!(rgb.iter().all(|c| c.len() == out.len()));
-    fill_parallel(out, |k| {
+    par_fill(out, |k| {
         let v = [rgb[0][k], rgb[1][k], rgb[2][k]];
         if v.iter().all(|c| !c.is_nan()) {
             [encode(v[0]), encode(v[1]), encode(v[2])]

@@ -9,11 +9,12 @@
 //!   edges, whose sign flips from one side of the edge to the other).
 //! - The score is `e / (e + HALF_DOLP)` with `e = dolp · coherence`, in `[0, 1)`.
 
-use polar_image::Gray;
+use polar_image::{Gray, par_map};
 use polar_imgproc::{Border, box_filter, median_blur};
 use polar_sensor::Observation;
+use rayon::prelude::*;
 
-use crate::TransparencyError;
+use crate::{TransparencyError, norm};
 
 /// Side of the averaging window (pixels, odd).
 pub const WINDOW: usize = 5;
@@ -27,8 +28,11 @@ pub struct CueMaps {
     pub dolp: Vec<f32>,
     /// Coherence of the polarization over the window, in `[0, 1]`.
     pub coherence: Vec<f32>,
-    /// Windowed AoLP in `[0, π)`.
-    pub aolp: Vec<f32>,
+    /// The windowed normalised Stokes vector `(S1/S0, S2/S0)` whose length is `dolp`
+    /// (scaled down where that length is clamped to 1).
+    pub q: Vec<f32>,
+    /// Its second component.
+    pub u: Vec<f32>,
 }
 
 /// Windowed mean of `v` where `valid`, 0 where the window holds no valid pixel.
@@ -39,16 +43,15 @@ fn masked_mean(
     w: usize,
     h: usize,
 ) -> Result<Vec<f32>, TransparencyError> {
-    let src = Gray::from_vec(w, h, v.iter().zip(valid).map(|(&a, &m)| a * m).collect())
-        .expect("size of the planes");
+    let src =
+        Gray::from_vec(w, h, par_map(w * h, |k| v[k] * valid[k])).expect("size of the planes");
     let mut dst = Gray::new(w, h);
     box_filter(&src, &mut dst, WINDOW, WINDOW, Border::Reflect101)?;
-    Ok(dst
-        .as_slice()
-        .iter()
-        .zip(mean_w)
-        .map(|(&s, &m)| if m > 0.0 { s / m } else { 0.0 })
-        .collect())
+    let sum = dst.as_slice();
+    Ok(par_map(w * h, |k| {
+        let m = mean_w[k];
+        if m > 0.0 { sum[k] / m } else { 0.0 }
+    }))
 }
 
 /// Side of the median filter applied to `S1/S0` and `S2/S0` before averaging.
@@ -73,28 +76,16 @@ pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
     let p = &obs.planes;
     let (s0, s1, s2) = (p.s0.as_slice(), p.s1.as_slice(), p.s2.as_slice());
     let n = w * h;
-    let valid: Vec<f32> = (0..n)
-        .map(|k| {
-            let ok = obs.is_valid(k)
-                && s0[k] > 0.0
-                && [s0[k], s1[k], s2[k]].iter().all(|v| v.is_finite());
-            f32::from(u8::from(ok))
-        })
-        .collect();
+    let valid: Vec<f32> = par_map(n, |k| {
+        let ok =
+            obs.is_valid(k) && s0[k] > 0.0 && [s0[k], s1[k], s2[k]].iter().all(|v| v.is_finite());
+        f32::from(u8::from(ok))
+    });
     // Stokes divided by S0 per pixel: the window then averages polarization states with
     // equal weight, whatever the texture's brightness, and the scale drops out.
-    let q: Vec<f32> = (0..n)
-        .map(|k| if valid[k] > 0.0 { s1[k] / s0[k] } else { 0.0 })
-        .collect();
-    let u: Vec<f32> = (0..n)
-        .map(|k| if valid[k] > 0.0 { s2[k] / s0[k] } else { 0.0 })
-        .collect();
-    let (q, u) = (median(q, w, h)?, median(u, w, h)?);
-    let d: Vec<f32> = q
-        .iter()
-        .zip(&u)
-        .map(|(a, b)| a.hypot(*b).min(1.0))
-        .collect();
+    let normalised = |s: &[f32]| par_map(n, |k| if valid[k] > 0.0 { s[k] / s0[k] } else { 0.0 });
+    let (q, u) = (median(normalised(s1), w, h)?, median(normalised(s2), w, h)?);
+    let d = par_map(n, |k| norm(q[k], u[k]).min(1.0));
     let wsrc = Gray::from_vec(w, h, valid.clone()).expect("size of the planes");
     let mut wmean = Gray::new(w, h);
     box_filter(&wsrc, &mut wmean, WINDOW, WINDOW, Border::Reflect101)?;
@@ -104,24 +95,29 @@ pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
         masked_mean(&u, &valid, mw, w, h)?,
         masked_mean(&d, &valid, mw, w, h)?,
     );
-    let mut dolp = vec![0.0; n];
-    let mut coherence = vec![0.0; n];
-    let mut aolp = vec![0.0; n];
-    for k in 0..n {
-        let r = qm[k].hypot(um[k]).min(1.0);
-        dolp[k] = if r.is_finite() { r } else { 0.0 };
-        coherence[k] = if dm[k] > 0.0 {
-            (dolp[k] / dm[k]).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let a = (0.5 * um[k].atan2(qm[k])).rem_euclid(std::f32::consts::PI);
-        aolp[k] = if a.is_finite() { a } else { 0.0 };
-    }
+    let (mut dolp, mut coherence) = (vec![0.0; n], vec![0.0; n]);
+    let (mut qw, mut uw) = (vec![0.0; n], vec![0.0; n]);
+    dolp.par_iter_mut()
+        .zip(&mut coherence)
+        .zip(&mut qw)
+        .zip(&mut uw)
+        .enumerate()
+        .with_min_len(1 << 14)
+        .for_each(|(k, (((d, c), q), u))| {
+            let r = norm(qm[k], um[k]);
+            let shrink = if r > 1.0 { 1.0 / r } else { 1.0 };
+            if r.is_finite() {
+                (*d, *q, *u) = (r.min(1.0), qm[k] * shrink, um[k] * shrink);
+            }
+            if dm[k] > 0.0 {
+                *c = (*d / dm[k]).clamp(0.0, 1.0);
+            }
+        });
     Ok(CueMaps {
         dolp,
         coherence,
-        aolp,
+        q: qw,
+        u: uw,
     })
 }
 
@@ -129,14 +125,9 @@ pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
 pub fn score(obs: &Observation) -> Result<Gray<f32>, TransparencyError> {
     let (w, h) = obs.size();
     let c = cue_maps(obs)?;
-    let s = c
-        .dolp
-        .iter()
-        .zip(&c.coherence)
-        .map(|(&d, &k)| {
-            let e = d * k;
-            e / (e + HALF_DOLP)
-        })
-        .collect();
+    let s = par_map(w * h, |k| {
+        let e = c.dolp[k] * c.coherence[k];
+        e / (e + HALF_DOLP)
+    });
     Ok(Gray::from_vec(w, h, s).expect("size of the observation"))
 }

@@ -7,14 +7,14 @@
 //! coherently over its extent, with an AoLP that follows its silhouette, where diffuse
 //! backgrounds return depolarized light ([`crate::cues`]).
 
-use polar_image::Gray;
+use polar_image::{Gray, par_map};
 use polar_imgproc::{Border, box_filter, sobel};
 use polar_learn::{Expect, Knn};
 use polar_sensor::Observation;
 use rayon::prelude::*;
 
-use crate::TransparencyError;
 use crate::cues::{CueMaps, cue_maps};
+use crate::{TransparencyError, norm};
 
 /// The task name in model files.
 pub const TASK: &str = "transparent";
@@ -94,10 +94,9 @@ impl FrameFeatures {
         let CueMaps {
             dolp,
             coherence,
-            aolp,
+            q,
+            u,
         } = c;
-        let q: Vec<f32> = par_map(n, |k| dolp[k] * (2.0 * aolp[k]).cos());
-        let u: Vec<f32> = par_map(n, |k| dolp[k] * (2.0 * aolp[k]).sin());
         let d2: Vec<f32> = par_map(n, |k| dolp[k] * dolp[k]);
         let ctx = |v: &[f32]| mean(v, w, h, CONTEXT);
         let (qc, uc, dc, d2c, cc) = (ctx(&q)?, ctx(&u)?, ctx(&dolp)?, ctx(&d2)?, ctx(&coherence)?);
@@ -118,13 +117,13 @@ impl FrameFeatures {
         let sd = par_map(n, |k| (d2c[k] - dc[k] * dc[k]).max(0.0).sqrt());
         let spread = par_map(n, |k| {
             if dc[k] > 0.0 {
-                (1.0 - qc[k].hypot(uc[k]) / dc[k]).clamp(0.0, 1.0)
+                (1.0 - norm(qc[k], uc[k]) / dc[k]).clamp(0.0, 1.0)
             } else {
                 1.0
             }
         });
         let pd = par_map(n, |k| {
-            let r = qc[k].hypot(uc[k]);
+            let r = norm(qc[k], uc[k]);
             if r > 0.0 {
                 (q[k] * qc[k] + u[k] * uc[k]) / r
             } else {
@@ -144,15 +143,6 @@ impl FrameFeatures {
     }
 }
 
-/// `f(k)` for every index `k < n`, in parallel, in index order.
-fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    (0..n)
-        .into_par_iter()
-        .with_min_len(1 << 14)
-        .map(f)
-        .collect()
-}
-
 /// Box mean of a plane over `side`² (reflected borders).
 fn mean(v: &[f32], w: usize, h: usize, side: usize) -> Result<Vec<f32>, TransparencyError> {
     let src = Gray::from_vec(w, h, v.to_vec()).expect("size of the planes");
@@ -168,7 +158,7 @@ fn gradient(v: &[f32], w: usize, h: usize) -> Result<Vec<f32>, TransparencyError
     sobel(&src, &mut gx, 1, 0, 3)?;
     sobel(&src, &mut gy, 0, 1, 3)?;
     let (gx, gy) = (gx.as_slice(), gy.as_slice());
-    Ok(par_map(w * h, |k| gx[k].hypot(gy[k])))
+    Ok(par_map(w * h, |k| norm(gx[k], gy[k])))
 }
 
 /// Per-pixel feature vectors ([`FEATURES`]), row-major, one per pixel.

@@ -176,3 +176,10 @@ pub fn detect(
         .expect("size of the observation");
     Ok(TransparencyMap { mask, score })
 }
+
+/// `√(a² + b²)` without `hypot`'s overflow guard (a libm call per pixel): the inputs are
+/// normalised Stokes components and image gradients, far from `f32`'s range.
+#[inline]
+pub(crate) fn norm(a: f32, b: f32) -> f32 {
+    (a * a + b * b).sqrt()
+}
