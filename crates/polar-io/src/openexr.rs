@@ -6,11 +6,12 @@ use std::fs::File;
 use std::io::{BufReader, Read, Seek};
 use std::path::Path;
 
+use exr::block::BlockIndex;
+use exr::block::writer::ChunksWriter;
 use exr::image::write::channels::WritableChannels;
 use exr::prelude::{
     AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Layer, LayerAttributes,
-    LineOrder, MetaData, ReadChannels, ReadLayers, SpecificChannels, Text, Vec2, WritableImage,
-    read,
+    LineOrder, MetaData, ReadChannels, ReadLayers, Text, WritableImage, read,
 };
 use polar_image::{Gray, Image};
 
@@ -63,19 +64,11 @@ pub fn write_exr_with<const C: usize, K>(
     names: [&str; C],
     compression: ExrCompression,
 ) -> Result<()> {
-    let path = path.as_ref();
-    let texts = channel_texts(path, &names)?;
-    nonempty(path, image.size())?;
-    let channels: Vec<AnyChannel<FlatSamples>> = texts
-        .into_iter()
-        .enumerate()
-        .map(|(c, name)| {
-            let plane = image.pixels().iter().map(|p| p[c]).collect();
-            AnyChannel::new(name, FlatSamples::F32(plane))
-        })
+    let planes: Vec<Vec<f32>> = (0..C)
+        .map(|c| image.pixels().iter().map(|p| p[c]).collect())
         .collect();
-    let channels = AnyChannels::sort(channels.into());
-    write_image(path, &single_layer(image.size(), compression, channels))
+    let planes: Vec<&[f32]> = planes.iter().map(Vec::as_slice).collect();
+    write_planes(path.as_ref(), image.size(), &planes, &names, compression)
 }
 
 /// Writes one plane as the float32 channel `name` of a single-layer EXR, atomically; the
@@ -87,15 +80,8 @@ pub fn write_exr_plane(
     compression: ExrCompression,
 ) -> Result<()> {
     let path = path.as_ref();
-    let [text] = channel_texts(path, &[name])?
-        .try_into()
-        .expect("one name gives one text");
-    let width = checked_size(path, &[plane])?.0;
-    let p = plane.as_slice();
-    let channels = SpecificChannels::build()
-        .with_channel(text)
-        .with_pixel_fn(|pos: Vec2<usize>| (p[pos.y() * width + pos.x()],));
-    write_image(path, &single_layer(plane.size(), compression, channels))
+    let size = checked_size(path, &[plane])?;
+    write_planes(path, size, &[plane.as_slice()], &[name], compression)
 }
 
 /// Writes three planes of one size as the float32 channels `names` of a single-layer EXR,
@@ -109,25 +95,19 @@ pub fn write_exr_planes3(
     compression: ExrCompression,
 ) -> Result<()> {
     let path = path.as_ref();
-    let [a, b, c] = channel_texts(path, &names)?
-        .try_into()
-        .expect("three names give three texts");
-    let (width, height) = checked_size(path, &planes)?;
-    let [pa, pb, pc] = planes.map(|p| p.as_slice());
-    let channels = SpecificChannels::build()
-        .with_channel(a)
-        .with_channel(b)
-        .with_channel(c)
-        .with_pixel_fn(|pos: Vec2<usize>| {
-            let k = pos.y() * width + pos.x();
-            (pa[k], pb[k], pc[k])
-        });
-    write_image(path, &single_layer((width, height), compression, channels))
+    let size = checked_size(path, &planes)?;
+    write_planes(
+        path,
+        size,
+        &planes.map(|p| p.as_slice()),
+        &names,
+        compression,
+    )
 }
 
 /// Writes any number of planes of one size as the float32 channels `names` (one per plane)
 /// of a single-layer EXR, atomically (e.g. the nine `S0.R` ... `S2.B` of a colour Stokes
-/// image). Each plane is copied once for the encoder; the file equals [`write_exr_with`]'s
+/// image), read in place like [`write_exr_planes3`]; the file equals [`write_exr_with`]'s
 /// of the same pixels.
 pub fn write_exr_planes(
     path: impl AsRef<Path>,
@@ -136,7 +116,6 @@ pub fn write_exr_planes(
     compression: ExrCompression,
 ) -> Result<()> {
     let path = path.as_ref();
-    let texts = channel_texts(path, names)?;
     if planes.len() != names.len() {
         return Err(Error::ChannelNames {
             path: path.to_owned(),
@@ -145,13 +124,56 @@ pub fn write_exr_planes(
         });
     }
     let size = checked_size(path, planes)?;
+    let planes: Vec<&[f32]> = planes.iter().map(|p| p.as_slice()).collect();
+    write_planes(path, size, &planes, names, compression)
+}
+
+/// Writes `planes` (row-major, all of `size`) as the float32 channels `names` of a
+/// single-layer scanline EXR, atomically. `exr` makes the header and compresses the blocks
+/// (in parallel); each block's bytes are copied from the planes' rows, channels in the
+/// file's alphabetical order (a per-pixel channel closure costs more than the copy).
+fn write_planes(
+    path: &Path,
+    size: (usize, usize),
+    planes: &[&[f32]],
+    names: &[&str],
+    compression: ExrCompression,
+) -> Result<()> {
+    let texts = channel_texts(path, names)?;
+    let (width, _) = nonempty(path, size)?;
+    let mut order: Vec<usize> = (0..planes.len()).collect();
+    order.sort_by(|&a, &b| texts[a].cmp(&texts[b]));
+    let sorted: Vec<&[f32]> = order.iter().map(|&i| planes[i]).collect();
     let channels: Vec<AnyChannel<FlatSamples>> = texts
         .into_iter()
-        .zip(planes)
-        .map(|(name, p)| AnyChannel::new(name, FlatSamples::F32(p.as_slice().to_vec())))
+        .map(|name| AnyChannel::new(name, FlatSamples::F32(Vec::new())))
         .collect();
-    let channels = AnyChannels::sort(channels.into());
-    write_image(path, &single_layer(size, compression, channels))
+    let layer = single_layer(size, compression, AnyChannels::sort(channels.into()));
+    let headers = layer.write().infer_meta_data();
+    write_file_atomic(path, Durability::Cached, |writer| {
+        exr::block::write(writer, headers, true, |meta, chunks| {
+            let blocks = meta.collect_ordered_block_data(|b| block_bytes(&sorted, width, b));
+            chunks
+                .on_progress(|_| ())
+                .compress_all_blocks_parallel(&meta, blocks)
+        })
+        .map_err(|e| exr_error(path, e))
+    })
+}
+
+/// The uncompressed bytes of one scanline block: per line, each plane's part of the row as
+/// little-endian f32.
+fn block_bytes(planes: &[&[f32]], width: usize, block: BlockIndex) -> Vec<u8> {
+    let (x0, y0) = (block.pixel_position.x(), block.pixel_position.y());
+    let (w, h) = (block.pixel_size.width(), block.pixel_size.height());
+    let mut out = Vec::with_capacity(w * h * planes.len() * 4);
+    for y in y0..y0 + h {
+        for plane in planes {
+            let row = &plane[y * width + x0..y * width + x0 + w];
+            out.extend(row.iter().flat_map(|v| v.to_le_bytes()));
+        }
+    }
+    out
 }
 
 /// The common size of `planes`, refusing an empty image or planes of different sizes.
@@ -193,19 +215,6 @@ fn single_layer<'c, C: WritableChannels<'c> + 'c>(
         channels,
     );
     exr::prelude::Image::from_layer(layer)
-}
-
-/// Writes `image` at `path`, atomically.
-fn write_image<'c, C: WritableChannels<'c>>(
-    path: &Path,
-    image: &'c exr::prelude::Image<Layer<C>>,
-) -> Result<()> {
-    write_file_atomic(path, Durability::Cached, |writer| {
-        image
-            .write()
-            .to_buffered(writer)
-            .map_err(|e| exr_error(path, e))
-    })
 }
 
 /// Reads the channels `names` (in that order) of a single-layer EXR into a `C`-channel image
