@@ -23,7 +23,8 @@ pub fn aolp_hsv(aolp: &Gray<f32>, dolp: &Gray<f32>) -> Rgb8 {
     out
 }
 
-/// [`aolp_hsv`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder).
+/// [`aolp_hsv`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder); the
+/// three slices have one length (else a panic: a caller's bug).
 pub fn aolp_hsv_into(aolp: &[f32], dolp: &[f32], out: &mut [[u8; 3]]) {
     assert!(aolp.len() == out.len() && dolp.len() == out.len());
     let table = full_saturation_table();
@@ -122,7 +123,8 @@ pub fn colormap(values: &Gray<f32>, vmin: f32, vmax: f32) -> Rgb8 {
     out
 }
 
-/// [`colormap`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder).
+/// [`colormap`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder); `values`
+/// and `out` have one length (else a panic: a caller's bug).
 pub fn colormap_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [[u8; 3]]) {
     let scale = if vmax > vmin {
         1.0 / (vmax - vmin)
@@ -141,7 +143,8 @@ pub fn colormap_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [[u8; 3]]) 
 }
 
 /// Linear R, G, B values divided by `vmax`, clipped to `[0, 1]` and encoded with the sRGB
-/// transfer function (IEC 61966-2-1) to 8 bits; a pixel with a NaN channel is black.
+/// transfer function (IEC 61966-2-1) to 8 bits; a pixel with a NaN channel is black. The four
+/// slices have one length (else a panic: a caller's bug).
 pub fn srgb_into(rgb: [&[f32]; 3], vmax: f32, out: &mut [[u8; 3]]) {
     let scale = if vmax > 0.0 { 1.0 / vmax } else { 0.0 };
     let encode = |v: f32| {
