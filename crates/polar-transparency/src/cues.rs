@@ -12,7 +12,6 @@
 use polar_image::{Gray, par_map};
 use polar_imgproc::{Border, box_filter, median_blur};
 use polar_sensor::Observation;
-use rayon::prelude::*;
 
 use crate::{TransparencyError, norm};
 
@@ -95,24 +94,25 @@ pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
         masked_mean(&u, &valid, mw, w, h)?,
         masked_mean(&d, &valid, mw, w, h)?,
     );
-    let (mut dolp, mut coherence) = (vec![0.0; n], vec![0.0; n]);
-    let (mut qw, mut uw) = (vec![0.0; n], vec![0.0; n]);
-    dolp.par_iter_mut()
-        .zip(&mut coherence)
-        .zip(&mut qw)
-        .zip(&mut uw)
-        .enumerate()
-        .with_min_len(1 << 14)
-        .for_each(|(k, (((d, c), q), u))| {
-            let r = norm(qm[k], um[k]);
-            let shrink = if r > 1.0 { 1.0 / r } else { 1.0 };
-            if r.is_finite() {
-                (*d, *q, *u) = (r.min(1.0), qm[k] * shrink, um[k] * shrink);
-            }
-            if dm[k] > 0.0 {
-                *c = (*d / dm[k]).clamp(0.0, 1.0);
-            }
-        });
+    // The windowed vector's length, clamped to 1 (the vector scaled down with it); 0 where
+    // not finite.
+    let r = par_map(n, |k| norm(qm[k], um[k]));
+    let scaled = |v: &[f32]| {
+        par_map(n, |k| match r[k] {
+            l if !l.is_finite() => 0.0,
+            l if l > 1.0 => v[k] / l,
+            _ => v[k],
+        })
+    };
+    let (qw, uw) = (scaled(&qm), scaled(&um));
+    let dolp = par_map(n, |k| if r[k].is_finite() { r[k].min(1.0) } else { 0.0 });
+    let coherence = par_map(n, |k| {
+        if dm[k] > 0.0 {
+            (dolp[k] / dm[k]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    });
     Ok(CueMaps {
         dolp,
         coherence,
