@@ -3,7 +3,7 @@
 //! [`crate::mask`] and what is known of the camera. Nothing here depends on where the
 //! frame came from (our renderer, another one, a real sensor).
 
-use polar_image::{Gray, quantile};
+use polar_image::{Gray, LinearStokesImage, quantile};
 use polar_optics::pixel_frame::{CameraModel, PixelFrame};
 
 use crate::mask::{SATURATED, ZERO};
@@ -68,6 +68,63 @@ impl Observation {
         quantile(valid, 0.99).filter(|&q| q > 0.0).unwrap_or(1.0)
     }
 
+    /// The observation of a camera with `f × f` times larger pixels: each block's mean
+    /// Stokes vector over its valid pixels (Stokes vectors of light add, so this is what
+    /// the larger pixel would measure, with `f` times less noise). Blocks at the right and
+    /// bottom edges may be smaller. A block is valid where at least half its pixels are,
+    /// else it carries the union of their flags. `f` of 0 or 1 gives a copy.
+    pub fn binned(&self, f: usize) -> Observation {
+        if f <= 1 {
+            return self.clone();
+        }
+        let (w, h) = self.size();
+        let (bw, bh) = (w.div_ceil(f), h.div_ceil(f));
+        let block = |k: usize| (k / w / f) * bw + (k % w) / f;
+        let mut members = vec![0u32; bw * bh];
+        let mut valid = vec![0u32; bw * bh];
+        let mut flags = vec![0u8; bw * bh];
+        for (k, &fk) in self.flags.as_slice().iter().enumerate() {
+            let b = block(k);
+            members[b] += 1;
+            match self.is_valid(k) {
+                true => valid[b] += 1,
+                false => flags[b] |= fk,
+            }
+        }
+        let means = |plane: &Gray<f32>| {
+            let mut sums = vec![0f64; bw * bh];
+            for (k, &v) in plane.as_slice().iter().enumerate() {
+                if self.is_valid(k) {
+                    sums[block(k)] += f64::from(v);
+                }
+            }
+            let m = sums.iter().zip(&valid);
+            let m = m.map(|(&s, &n)| {
+                if n == 0 {
+                    0.0
+                } else {
+                    (s / f64::from(n)) as f32
+                }
+            });
+            Gray::from_vec(bw, bh, m.collect()).expect("sized")
+        };
+        let p = &self.planes;
+        let stokes =
+            LinearStokesImage::from_channels([&means(&p.s0), &means(&p.s1), &means(&p.s2)])
+                .expect("same sizes");
+        for ((fl, &n), &m) in flags.iter_mut().zip(&valid).zip(&members) {
+            if 2 * n >= m {
+                *fl = 0;
+            }
+        }
+        Observation {
+            planes: StokesPlanes::from_linear_stokes(&stokes),
+            s3: self.s3.as_ref().map(means),
+            flags: Gray::from_vec(bw, bh, flags).expect("sized"),
+            camera: self.camera,
+        }
+    }
+
     /// The ray and Stokes frame through the centre of pixel `(x, y)`.
     pub fn pixel_frame(&self, x: usize, y: usize) -> PixelFrame {
         let (w, h) = self.size();
@@ -103,5 +160,42 @@ mod tests {
         assert_eq!(o.s0_scale(), 99.0);
         let dark = Observation::new(planes(&[0.0; 4]), CameraModel::Orthographic);
         assert_eq!(dark.s0_scale(), 1.0);
+    }
+
+    #[test]
+    fn binning_adds_stokes_vectors_so_crossed_polarizations_cancel() {
+        // A 3x2 image binned by 2: block 0 holds +S1 and -S1 light (DoLP 1 each) whose sum
+        // is unpolarized; block 1 is the partial right column.
+        let mut p = StokesPlanes::new(3, 2);
+        p.s0.as_mut_slice()
+            .copy_from_slice(&[1.0, 1.0, 2.0, 1.0, 1.0, 4.0]);
+        p.s1.as_mut_slice()
+            .copy_from_slice(&[1.0, -1.0, 2.0, 1.0, -1.0, 0.0]);
+        let o = Observation::new(p, CameraModel::Orthographic).binned(2);
+        assert_eq!(o.size(), (2, 1));
+        assert_eq!(o.planes.s0.as_slice(), [1.0, 3.0]);
+        assert_eq!(o.planes.s1.as_slice(), [0.0, 1.0]);
+        assert_eq!(o.planes.dolp.as_slice(), [0.0, 1.0 / 3.0]);
+        assert!(o.is_valid(0) && o.is_valid(1));
+    }
+
+    #[test]
+    fn a_block_is_valid_when_at_least_half_its_pixels_are() {
+        // Block 0: one saturated pixel of four (valid, mean of the other three);
+        // block 1: three flagged of four (invalid, union of the flags).
+        let s0 = [1.0, 8.0, 5.0, 0.0, 3.0, 2.0, 0.0, 7.0];
+        let mut p = StokesPlanes::new(4, 2);
+        p.s0.as_mut_slice().copy_from_slice(&s0);
+        let mut flags = Gray::new(4, 2);
+        flags
+            .as_mut_slice()
+            .copy_from_slice(&[0, SATURATED, SATURATED, ZERO, 0, 0, ZERO, 0]);
+        let o = Observation::new(p, CameraModel::Orthographic).with_flags(flags);
+        let b = o.binned(2);
+        assert_eq!(b.planes.s0.as_slice()[0], 2.0);
+        assert!(b.is_valid(0));
+        assert!(!b.is_valid(1));
+        assert_eq!(b.flags.as_slice()[1], SATURATED | ZERO);
+        assert_eq!(o.binned(1).planes, o.planes);
     }
 }

@@ -7,7 +7,8 @@
 //! [--only TEXT] [--no-speed] [--ior N|auto]` (default `/work/data/dev`; samples `sfp-*` and
 //! the Mitsuba task scenes `mts-shape-*`; `--only` keeps names containing TEXT, `--no-speed`
 //! skips the timing of upscaled frames, `--ior` as `polar-vision run --ior`, default 1.5,
-//! `--oracle-fg` also runs the local method on the true object mask).
+//! `--oracle-fg` also runs the local method on the true object mask, `--working-size` as
+//! `polar-vision run --sfp-working-size`).
 //! Each line also gives the index used and its source, and the true indices of the
 //! sample's objects from its meta.json (read here for evaluation only), and the light
 //! fitted to the shading (direction in the camera frame, strength, ambient). The Stokes planes come from the raw mosaic (residual
@@ -34,6 +35,8 @@ struct Args {
     ior: IorOption,
     /// Also run the local method on the true object mask.
     oracle_fg: bool,
+    /// `ShapeOptions::working_size`.
+    working_size: usize,
 }
 
 fn args() -> Args {
@@ -45,6 +48,7 @@ fn args() -> Args {
         speed: true,
         ior: IorOption::Default,
         oracle_fg: false,
+        working_size: polar_shape::scale::WORKING_SIZE,
     };
     let mut it = std::env::args().skip(1);
     while let Some(s) = it.next() {
@@ -54,13 +58,19 @@ fn args() -> Args {
             "--only" => a.only = it.next(),
             "--no-speed" => a.speed = false,
             "--oracle-fg" => a.oracle_fg = true,
+            "--working-size" => {
+                let v = it.next().unwrap_or_default();
+                a.working_size = v
+                    .parse()
+                    .unwrap_or_else(|e| panic!("--working-size {v}: {e}"));
+            }
             "--ior" => {
                 let v = it.next().unwrap_or_default();
                 a.ior = v.parse().unwrap_or_else(|e| panic!("--ior {v}: {e}"));
             }
             "--help" | "-h" => {
                 println!(
-                    "eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto] [--oracle-fg]"
+                    "eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto] [--oracle-fg] [--working-size N]"
                 );
                 std::process::exit(0);
             }
@@ -155,6 +165,7 @@ fn main() {
                 method: m,
                 integrator: Integrator::Poisson,
                 ior: a.ior,
+                working_size: a.working_size,
             };
             let t = Instant::now();
             let shape = estimate_shape(&obs, &opts).unwrap();
@@ -439,7 +450,7 @@ fn speed(dir: &Path) {
                 let opts = ShapeOptions {
                     method: m,
                     integrator: integ,
-                    ior: IorOption::Default,
+                    ..ShapeOptions::default()
                 };
                 let t = Instant::now();
                 estimate_shape(&obs, &opts).unwrap();

@@ -60,9 +60,7 @@ impl Cues {
             .into_par_iter()
             .map(|k| {
                 let (a, b, c) = (f64::from(s0[k]), f64::from(s1[k]), f64::from(s2[k]));
-                let ok =
-                    obs.is_valid(k) && a > 0.0 && a.is_finite() && b.is_finite() && c.is_finite();
-                if !ok {
+                if !usable(obs, k) {
                     return (0.0, 0.0, 0.0, false, 0.0);
                 }
                 let s = a / scale;
@@ -112,6 +110,17 @@ impl Cues {
             && (f64::from(self.dolp[k]) > self.models.diffuse_max + DIFFUSE_MARGIN
                 || f64::from(self.s0n[k]) > HIGHLIGHT)
     }
+}
+
+/// `true` where pixel `k` of `obs` is valid (flags clear) with finite Stokes and S0 > 0.
+pub fn usable(obs: &Observation, k: usize) -> bool {
+    let p = &obs.planes;
+    let s0 = p.s0.as_slice()[k];
+    obs.is_valid(k)
+        && s0 > 0.0
+        && [s0, p.s1.as_slice()[k], p.s2.as_slice()[k]]
+            .iter()
+            .all(|v| v.is_finite())
 }
 
 /// The frame angle (from `x_ref` toward `y_ref`) of an image-plane direction

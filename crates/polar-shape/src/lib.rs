@@ -30,6 +30,7 @@ pub mod global;
 pub mod integrate;
 pub mod ior;
 pub mod local;
+pub mod scale;
 pub mod zenith;
 
 #[cfg(test)]
@@ -146,7 +147,8 @@ impl fmt::Display for Integrator {
     }
 }
 
-/// Options of [`estimate_shape`]; the default is local, Poisson, index [`DEFAULT_IOR`].
+/// Options of [`estimate_shape`]; the default is local, Poisson, index [`DEFAULT_IOR`],
+/// working scale [`scale::WORKING_SIZE`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShapeOptions {
     /// Disambiguation method.
@@ -156,6 +158,8 @@ pub struct ShapeOptions {
     pub integrator: Integrator,
     /// How the relative refractive index of the objects is chosen.
     pub ior: IorOption,
+    /// Long side (pixels) of the working scale ([`scale`]); larger images are binned.
+    pub working_size: usize,
 }
 
 impl Default for ShapeOptions {
@@ -164,6 +168,7 @@ impl Default for ShapeOptions {
             method: Method::Local,
             integrator: Integrator::Poisson,
             ior: IorOption::Default,
+            working_size: scale::WORKING_SIZE,
         }
     }
 }
@@ -288,6 +293,22 @@ pub fn estimate_shape(obs: &Observation, opts: &ShapeOptions) -> Result<Shape, S
     if !(given.is_finite() && given > 1.0) {
         return Err(ShapeError::InvalidIor(given));
     }
+    match scale::working_factor(w, h, opts.working_size) {
+        1 => estimate_at_scale(obs, opts, given),
+        f => {
+            let coarse = estimate_at_scale(&obs.binned(f), opts, given)?;
+            Ok(scale::Grid { w, h, f }.upsample(coarse, obs))
+        }
+    }
+}
+
+/// [`estimate_shape`] in the observation's own pixels, `given` the starting index.
+fn estimate_at_scale(
+    obs: &Observation,
+    opts: &ShapeOptions,
+    given: f64,
+) -> Result<Shape, ShapeError> {
+    let (w, h) = obs.size();
     // The foreground does not depend on the index, so the index can be estimated on it.
     let mut cues = cues::Cues::new(obs, given)?;
     let fg = foreground::foreground(&cues)?;

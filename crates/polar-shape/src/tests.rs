@@ -21,6 +21,7 @@ fn opts(method: Method, ior: Option<f64>) -> ShapeOptions {
         method,
         integrator: Integrator::Poisson,
         ior: ior.map_or(IorOption::Default, IorOption::Given),
+        ..ShapeOptions::default()
     }
 }
 
@@ -422,6 +423,7 @@ fn tiny_images() {
                     method,
                     integrator: integ,
                     ior: IorOption::Default,
+                    ..ShapeOptions::default()
                 };
                 let shape = estimate_shape(&obs, &o).unwrap();
                 for p in shape.normal.pixels() {
@@ -437,6 +439,45 @@ fn tiny_images() {
     assert_eq!(
         estimate_shape(&empty, &ShapeOptions::default()).unwrap_err(),
         ShapeError::Empty(0, 0)
+    );
+}
+
+#[test]
+fn resolution_independence() {
+    // The sphere of `synthetic_sphere_end_to_end` seen by a camera with 8x finer pixels,
+    // each with polarization noise of DoLP up to 0.1 (the diffuse sphere's own DoLP is
+    // below 0.04 over most of its face). Worked on at the working scale (768 / 3 = 256
+    // pixels, a third of the noise) the errors are 4.4 degrees median, 6.2 mean; in the
+    // full 768 pixels the noise flips azimuths: 17.8 and 25.1. Bounds 6 and 9.
+    let mut scene = sphere_scene(768, 1.5);
+    add_polarization_noise(&mut scene, 0.1);
+    let obs = scene.observation(1.0);
+    let mask = scene.object_mask();
+    let error = |working_size| {
+        let o = ShapeOptions {
+            working_size,
+            ..opts(Method::Local, Some(1.5))
+        };
+        let shape = estimate_shape(&obs, &o).unwrap();
+        let err = angular_error(&shape.normal, &scene.normal_image(), Some(&mask));
+        (err.unwrap().unwrap(), shape)
+    };
+    let (full, _) = error(0);
+    assert!(
+        full.mean > 15.0,
+        "the noise is too weak to test anything: {full:?}"
+    );
+    let (err, shape) = error(crate::scale::WORKING_SIZE);
+    assert!(err.median < 6.0 && err.mean < 9.0, "{err:?}");
+    let iou = polar_imgproc::iou(&shape.foreground, &mask)
+        .unwrap()
+        .unwrap();
+    assert!(iou > 0.95, "foreground IoU {iou}");
+    // Depth is interpolated too, and finite exactly on the foreground.
+    let fg = shape.foreground.as_slice().iter();
+    assert!(
+        fg.zip(shape.depth.as_slice())
+            .all(|(&f, d)| (f != 0) == d.is_finite())
     );
 }
 

@@ -23,6 +23,7 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
         method: args.sfp_method,
         integrator: args.integrator,
         ior: args.ior.unwrap_or_default(),
+        working_size: args.sfp_working_size,
     };
     let shape = estimate_shape(ctx.obs, &opts).map_err(|e| Failure::CannotRun(e.to_string()))?;
     write(ctx, &shape)?;
