@@ -41,11 +41,12 @@ pub struct TaskArgs {
     #[arg(verbatim_doc_comment)]
     #[arg(long, value_name = "NAME", default_value = "poisson", value_parser = parse_name::<Integrator>)]
     pub integrator: Integrator,
-    /// Shape from polarization works in an image of at most about this many pixels on its
-    /// long side: larger frames are binned (their Stokes vectors averaged over blocks, as
-    /// larger pixels would measure them) and the results interpolated back. Its windows
-    /// are a few pixels wide, so this makes it independent of the camera's resolution,
-    /// less sensitive to noise, and fast. 0 works in the frame's own pixels.
+    /// Shape from polarization works in an image with this many pixels on its long side, up
+    /// to twice as many: a larger frame is binned by the largest factor that keeps it at
+    /// least this long (Stokes vectors averaged over blocks, as larger pixels would measure
+    /// them) and the results are interpolated back. Its windows are a few pixels wide, so
+    /// this makes it independent of the camera's resolution, less sensitive to noise, and
+    /// fast. 0 works in the frame's own pixels.
     #[arg(long, value_name = "PIXELS", default_value_t = polar_shape::scale::WORKING_SIZE)]
     pub sfp_working_size: usize,
     /// Dehazing method:
