@@ -2,9 +2,10 @@
 //!
 //! - Fresnel cue (Wolff 1990): a DoLP above the largest specular DoLP a metal of
 //!   [`crate::fresnel_cues::METAL_INDICES`] reaches at that zenith cannot come from a
-//!   metal. Where the zenith is the silhouette's sphere prior, the envelope may be taken
-//!   [`PRIOR_MARGIN_DEG`] further toward grazing (the envelope is a running maximum over
-//!   the zenith), trading missed dielectrics for fewer false ones.
+//!   metal. The envelope is read [`MEASURED_MARGIN_DEG`] further toward grazing where
+//!   the zenith is the shape task's, [`PRIOR_MARGIN_DEG`] where it is the silhouette's
+//!   sphere prior (the envelope is a running maximum over the zenith), trading missed
+//!   dielectrics for fewer false ones.
 //! - Phase cue: light polarized along the surface azimuth (phase `> 0`) is diffuse light
 //!   leaving a dielectric; metals have no diffuse lobe, so their light is polarized
 //!   across the azimuth. Polarization across the azimuth decides nothing by itself: a
@@ -26,6 +27,12 @@ pub const FRESNEL_MARGIN: f32 = 0.03;
 /// Widening of the zenith of the sphere prior toward grazing, degrees (0: the prior as
 /// is, which on the dev set classified more pixels right than 15°).
 pub const PRIOR_MARGIN_DEG: f32 = 0.0;
+/// Widening of a measured zenith (the shape task's normals) toward grazing, degrees. That
+/// zenith comes from a dielectric's polarization model and a smoothness field and is off
+/// by 10-25° on average; read at too small a zenith, the envelope is too low and a metal's
+/// own DoLP passes the Fresnel cue. With the margin, the cue fires only on DoLP no metal
+/// reaches within the zenith's typical error.
+pub const MEASURED_MARGIN_DEG: f32 = 20.0;
 /// Fraction of a region's pixels above the metal envelope at which the Fresnel cue
 /// changes its vote (isolated pixels are noise or demosaicing edges).
 const OVER_FRACTION: f32 = 0.06;
@@ -44,11 +51,12 @@ fn envelope(cues: &Cues, table: &FresnelTable, k: usize) -> f32 {
     if !z.is_finite() {
         return table.metal_ceiling();
     }
-    let z = if cues.prior {
-        (z + PRIOR_MARGIN_DEG.to_radians()).min(std::f32::consts::FRAC_PI_2)
+    let margin = if cues.prior {
+        PRIOR_MARGIN_DEG
     } else {
-        z
+        MEASURED_MARGIN_DEG
     };
+    let z = (z + margin.to_radians()).min(std::f32::consts::FRAC_PI_2);
     table.metal_max(z)
 }
 
