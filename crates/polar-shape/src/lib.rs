@@ -2,7 +2,9 @@
 //! confidence map and a per-pixel reflection type from one linear-polarization
 //! observation ([`polar_sensor::Observation`]).
 //!
-//! Pipeline ([`estimate_shape`]):
+//! Pipeline ([`estimate_shape`]), at the working scale ([`scale`]: a frame much larger
+//! than [`scale::WORKING_SIZE`] is binned, the steps run there and their results are
+//! interpolated back to the frame's pixels):
 //! 1. Per-pixel cues ([`cues`]): S0 normalised by [`Observation::s0_scale`], DoLP,
 //!    AoLP, a confidence from the DoLP's signal-to-noise ratio and the validity flags.
 //! 2. Foreground ([`foreground`]): objects are the regions enclosed by strong

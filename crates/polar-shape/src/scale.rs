@@ -1,16 +1,16 @@
-//! The working scale: shape from polarization works in an image of about
-//! [`WORKING_SIZE`] pixels on its long side (`ShapeOptions::working_size`), whatever the
+//! The working scale: shape from polarization works in an image of [`WORKING_SIZE`] to
+//! twice as many pixels on its long side (`ShapeOptions::working_size`), whatever the
 //! camera's resolution, and interpolates its results to the camera's pixels.
 //!
-//! Their windows (edge smoothing, AoLP coherence, the smoothness field) are a few pixels
+//! The methods' windows (edge smoothing, AoLP coherence, the smoothness field) are a few pixels
 //! wide. In a much finer image an object's edges spread over many pixels, sensor noise
 //! breaks its polarization field into fragments, and smoothness carries the contour's
 //! evidence only a few pixels inward. So a finer image is binned as a camera with larger
 //! pixels would see it (`Observation::binned`: the mean Stokes vector, `f` times less
 //! noise), and the normals, depth, confidence and reflection types found there are
-//! brought back to the camera's pixels ([`Grid::upsample`]). Choosing each fine pixel's
-//! own candidate against the interpolated normals scored slightly worse on the 512-pixel
-//! shape scenes (docs/benchmarks.md): at that noise the finer pixels add noise, not shape.
+//! brought back to the camera's pixels ([`Grid::upsample`]), as they are: letting each
+//! fine pixel choose its own candidate against the interpolated normals adds the fine
+//! pixels' noise rather than shape (docs/benchmarks.md).
 
 use nalgebra::Vector3;
 use polar_image::{Gray, Image};
@@ -51,7 +51,7 @@ impl Grid {
 
     /// The shape of the fine observation `obs` from `coarse`, the shape of `obs` binned:
     /// the foreground, reflection types and confidence of each pixel's block, normals and
-    /// depth interpolated between block centres ([`Self::interpolate`]; depth in fine
+    /// depth interpolated bilinearly between block centres (depth in fine
     /// pixels), nothing on pixels that are not [`usable`].
     pub fn upsample(&self, coarse: Shape, obs: &Observation) -> Shape {
         let (w, h) = (self.w, self.h);
