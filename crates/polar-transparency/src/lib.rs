@@ -16,8 +16,9 @@
 //! grazing) and little where it faces the camera, so the seeds are open arcs around
 //! the object; glass objects (balls, slabs, cups, bottles) are mostly convex.
 //!
-//! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass, and
-//! neither segmenter tells them apart reliably (docs/benchmarks.md measures the false
+//! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass. A
+//! region much darker than its surroundings is dropped ([`SEE_THROUGH`]: glass lets the
+//! background through); brighter ones neither segmenter tells apart reliably (docs/benchmarks.md measures the false
 //! positives on them; the kNN adds the polarization-difference contrast, the AoLP spread
 //! and intensity edges to the cues, [`knn::FEATURES`]).
 //!
@@ -172,10 +173,56 @@ pub fn detect(
     let m = polar_imgproc::mask::clean(&seed, w, h)?;
     let m = polar_imgproc::mask::remove_small(&m, w, h, MIN_WINDOWS * cues::WINDOW.pow(2))?;
     let m = polar_imgproc::mask::convex_hull_objects(&m, w, h)?;
+    let m = without_dark_regions(obs, m)?;
     let mask = Gray::from_vec(w, h, m.iter().map(|&b| if b { ON } else { 0 }).collect())
         .expect("size of the observation");
     Ok(TransparencyMap { mask, score })
 }
+
+/// `mask` without the components whose median S0 is below [`SEE_THROUGH`] times the
+/// median S0 of the ring around them ([`RING`] pixels wide; a ring pixel near two
+/// components counts for the one with the larger label).
+fn without_dark_regions(
+    obs: &Observation,
+    mask: Vec<bool>,
+) -> Result<Vec<bool>, TransparencyError> {
+    let (w, h) = obs.size();
+    let (id, n) = polar_imgproc::mask::components(&mask, w, h)?;
+    if n == 0 {
+        return Ok(mask);
+    }
+    let ids = Gray::from_vec(w, h, id.iter().map(|&i| i as f32).collect()).expect("size");
+    let mut ring = Gray::new(w, h);
+    polar_imgproc::max_filter(&ids, &mut ring, 2 * RING + 1, 2 * RING + 1)?;
+    let mut inside = vec![Vec::new(); n + 1];
+    let mut around = vec![Vec::new(); n + 1];
+    let s0 = obs.planes.s0.as_slice();
+    for k in (0..w * h).filter(|&k| obs.is_valid(k)) {
+        match id[k] {
+            0 => around[ring.as_slice()[k] as usize].push(s0[k]),
+            c => inside[c as usize].push(s0[k]),
+        }
+    }
+    let median = |v: &[f32]| polar_image::quantile(v.iter().copied(), 0.5);
+    let keep: Vec<bool> = (0..=n)
+        .map(|c| match (median(&inside[c]), median(&around[c])) {
+            (Some(i), Some(a)) => i >= SEE_THROUGH * a,
+            _ => true,
+        })
+        .collect();
+    Ok((0..w * h)
+        .map(|k| mask[k] && keep[id[k] as usize])
+        .collect())
+}
+
+/// Glass passes about 90 % of the light behind it (two interfaces, little absorption), so
+/// a glass region is about as bright as what surrounds it, whereas a dark glossy opaque
+/// object, polarized as strongly, returns only its surface reflection: regions darker
+/// than this share of their surroundings' median S0 are dropped. Below a half, to leave
+/// room for glass over the darker parts of a backdrop and for its refracted view.
+pub const SEE_THROUGH: f32 = 0.4;
+/// Width (pixels) of the ring whose brightness [`without_dark_regions`] compares.
+const RING: usize = 10;
 
 /// `√(a² + b²)` without `hypot`'s overflow guard (a libm call per pixel): the inputs are
 /// normalised Stokes components and image gradients, far from `f32`'s range.

@@ -99,6 +99,26 @@ fn glass_disc_over_checkerboard_is_found() {
     assert!(out.score.as_slice().iter().all(|s| (0.0..=1.0).contains(s)));
 }
 
+/// A dark glossy opaque disc polarizes like glass (here its reflection is as polarized as
+/// the glass's transmission, and stronger) but returns a tenth of the light around it:
+/// no glass. The same disc at 0.9 of the backdrop's brightness stays glass.
+#[test]
+fn dark_glossy_opaque_disc_is_no_glass() {
+    for (brightness, glass) in [(0.1, false), (0.9, true)] {
+        let obs = observation(|x, y| match disc(x, y) {
+            Some((ze, az)) => (
+                brightness * 0.5,
+                (2.0 * transmitted_dolp(ze, 1.5)).min(1.0),
+                az + FRAC_PI_2,
+            ),
+            None => (checker(x, y), 0.0, 0.0),
+        });
+        let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
+        let iou = iou_with_disc(&out.mask);
+        assert_eq!(iou > 0.8, glass, "brightness {brightness}: IoU {iou}");
+    }
+}
+
 /// Glass lit so that only part of its rim is polarized: reflection of a bright window on
 /// one side, the rest of the disc transmitting the depolarized checkerboard at DoLP 0.
 /// The seed is an open arc (a C) that hole filling cannot close; the convex hull does, up
