@@ -28,10 +28,11 @@ pub const FRESNEL_MARGIN: f32 = 0.03;
 /// is, which on the dev set classified more pixels right than 15°).
 pub const PRIOR_MARGIN_DEG: f32 = 0.0;
 /// Widening of a measured zenith (the shape task's normals) toward grazing, degrees. That
-/// zenith comes from a dielectric's polarization model and a smoothness field and is off
-/// by 10-25° on average; read at too small a zenith, the envelope is too low and a metal's
-/// own DoLP passes the Fresnel cue. With the margin, the cue fires only on DoLP no metal
-/// reaches within the zenith's typical error.
+/// zenith comes from a dielectric's polarization model and a smoothness field, and a
+/// rough metal's light leaves facets tilted beyond the mean surface; read at too small a
+/// zenith, the envelope is too low and a metal's own DoLP passes the Fresnel cue. With
+/// the margin, the cue fires only on DoLP no metal reaches within the shape task's
+/// typical zenith error (docs/benchmarks.md).
 pub const MEASURED_MARGIN_DEG: f32 = 20.0;
 /// Fraction of a region's pixels above the metal envelope at which the Fresnel cue
 /// changes its vote (isolated pixels are noise or demosaicing edges).
