@@ -53,7 +53,10 @@
 //! dropped (specks; every object polarizes somewhere). Regions inside the frame are
 //! not held to the contour signature: on glossy objects the diffuse and specular parts
 //! cancel along stretches of the rim, and the shape prior checks it per boundary pixel
-//! instead (`crate::local`).
+//! instead (`crate::local`). Last, the gaps between a component and its convex hull that
+//! the component mostly borders and that are as bright as it are filled
+//! ([`fill_hull_gaps`]): a white object on a light floor is found as the open arcs of its
+//! rim, its face toward the camera too weakly polarized and edged for either cue.
 //!
 //! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
 //! the view, a tiny image), every valid pixel is foreground: the frame shows one surface
@@ -103,6 +106,11 @@ const RING_FAR: u32 = 6;
 /// Width (4-connected steps) of the dilated edges between an edge-free interior and
 /// the object around it.
 const EDGE_BAND: u32 = 4;
+/// Fraction of the pixels next to a gap between a component and its convex hull that must
+/// be the component for the gap to be filled ([`fill_hull_gaps`]): a face between the
+/// arcs of its rim is mostly bordered by them, the floor between two objects by the hull's
+/// chords as well.
+const HULL_ENCLOSURE: f64 = 0.7;
 /// Fraction of the ring around an interior region that must be foreground for the
 /// region to be a hole.
 const HOLE_ENCLOSURE: f64 = 0.9;
@@ -162,6 +170,7 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         .map(|k| coherent.regions[k] || enclosed.interiors[k])
         .collect();
     let fg = with_evidence(fg, &evidence, w, h)?;
+    let fg = fill_hull_gaps(cues, fg)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -416,6 +425,57 @@ fn with_evidence(
         has[id[k] as usize] = true;
     }
     Ok((0..w * h).map(|k| fg[k] && has[id[k] as usize]).collect())
+}
+
+/// `fg` with the gaps between each component and its convex hull that the component
+/// borders on at least [`HULL_ENCLOSURE`] of the pixels next to them and that do not look
+/// like the background ([`looks_through`]): an object's face between the coherent arcs of
+/// its rim, as bright as the rim, rather than the floor seen between two objects.
+pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let hull = polar_imgproc::mask::convex_hull_objects(&fg, w, h)?;
+    let gaps: Vec<bool> = (0..w * h)
+        .map(|k| hull[k] && !fg[k] && cues.valid[k])
+        .collect();
+    let (id, n) = components(&gaps, w, h)?;
+    if n == 0 {
+        return Ok(fg);
+    }
+    let outside = median(
+        ring(&hull, w, h, 1..=RING_FAR)
+            .into_iter()
+            .filter(|&k| cues.valid[k])
+            .map(|k| log_brightness(cues, k))
+            .collect(),
+    );
+    let (owner, dist) = grow_labels(&id, w, h, RING_FAR, |_| true);
+    let mut gap: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    let mut object: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    // Pixels next to the gap (2 steps): all, and those of the object.
+    let mut near = vec![[0usize; 2]; n + 1];
+    for k in (0..w * h).filter(|&k| (1..=2).contains(&dist[k])) {
+        near[owner[k] as usize][0] += 1;
+        near[owner[k] as usize][1] += usize::from(fg[k]);
+    }
+    for k in (0..w * h).filter(|&k| dist[k] != u32::MAX && cues.valid[k]) {
+        match (dist[k], fg[k]) {
+            (0, _) => gap[owner[k] as usize].push(log_brightness(cues, k)),
+            (_, true) => object[owner[k] as usize].push(log_brightness(cues, k)),
+            _ => {}
+        }
+    }
+    let fill: Vec<bool> = (0..=n)
+        .map(|c| {
+            c > 0
+                && near[c][1] as f64 >= HULL_ENCLOSURE * near[c][0] as f64
+                && !looks_through(
+                    median(std::mem::take(&mut gap[c])),
+                    median(std::mem::take(&mut object[c])),
+                    outside,
+                )
+        })
+        .collect();
+    Ok((0..w * h).map(|k| fg[k] || fill[id[k] as usize]).collect())
 }
 
 /// A hole whose median log brightness is closer to the background's around the objects

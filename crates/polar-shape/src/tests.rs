@@ -1093,3 +1093,38 @@ fn light_fitted_to_a_lambertian_sphere() {
         }
     }
 }
+
+/// A C-shaped foreground (the coherent arc of a white object's rim, open to the right)
+/// around a face as bright as the arc is closed to the arc's convex hull; the same face
+/// as dark as the floor around is the floor seen through a gap and stays out.
+#[test]
+fn face_between_rim_arcs_is_filled_floor_is_not() {
+    let n = 48;
+    let inside = |x: usize, y: usize| {
+        let (dx, dy) = (x as f64 + 0.5 - 24.0, y as f64 + 0.5 - 24.0);
+        (dx.hypot(dy) < 14.0).then_some((dx, dy))
+    };
+    // The arc: the disc's outer 4 pixels except a 60-degree opening toward +x.
+    let arc = |x: usize, y: usize| {
+        inside(x, y).is_some_and(|(dx, dy)| dx.hypot(dy) >= 10.0 && dy.atan2(dx).abs() > 0.5)
+    };
+    for (face, filled) in [(0.8f32, true), (0.2, false)] {
+        let s0: Vec<f32> = (0..n * n)
+            .map(|k| match (arc(k % n, k / n), inside(k % n, k / n)) {
+                (true, _) => 0.8,
+                (false, Some(_)) => face,
+                _ => 0.2,
+            })
+            .collect();
+        let obs = uniform_observation(n, n, [1.0, 0.0, 0.0], CameraModel::Orthographic);
+        let mut planes = obs.planes.clone();
+        planes.s0.as_mut_slice().copy_from_slice(&s0);
+        let cues = Cues::new(&Observation::new(planes, CameraModel::Orthographic), 1.5).unwrap();
+        let fg: Vec<bool> = (0..n * n).map(|k| arc(k % n, k / n)).collect();
+        let out = crate::foreground::fill_hull_gaps(&cues, fg).unwrap();
+        let centre = out[24 * n + 24];
+        assert_eq!(centre, filled, "face brightness {face}");
+        // Nothing outside the disc is ever added.
+        assert!((0..n * n).all(|k| !out[k] || inside(k % n, k / n).is_some() || arc(k % n, k / n)));
+    }
+}
