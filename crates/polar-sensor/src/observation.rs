@@ -80,13 +80,14 @@ impl Observation {
         let (w, h) = self.size();
         let (bw, bh) = (w.div_ceil(f), h.div_ceil(f));
         let block = |k: usize| (k / w / f) * bw + (k % w) / f;
+        let ok: Vec<bool> = (0..w * h).map(|k| self.is_valid(k)).collect();
         let mut members = vec![0u32; bw * bh];
         let mut valid = vec![0u32; bw * bh];
         let mut flags = vec![0u8; bw * bh];
         for (k, &fk) in self.flags.as_slice().iter().enumerate() {
             let b = block(k);
             members[b] += 1;
-            match self.is_valid(k) {
+            match ok[k] {
                 true => valid[b] += 1,
                 false => flags[b] |= fk,
             }
@@ -94,7 +95,7 @@ impl Observation {
         let means = |plane: &Gray<f32>| {
             let mut sums = vec![0f64; bw * bh];
             for (k, &v) in plane.as_slice().iter().enumerate() {
-                if self.is_valid(k) {
+                if ok[k] {
                     sums[block(k)] += f64::from(v);
                 }
             }

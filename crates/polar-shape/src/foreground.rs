@@ -358,13 +358,7 @@ pub(crate) fn open_see_through_holes(
         .iter()
         .map(|&[all, pol]| pol as f64 >= POLARIZED_INTERIOR * all as f64 && pol > 0)
         .collect();
-    let outside = median(
-        ring(&fg, w, h, 1..=RING_FAR)
-            .into_iter()
-            .filter(|&k| cues.valid[k])
-            .map(|k| log_brightness(cues, k))
-            .collect(),
-    );
+    let outside = brightness_around(cues, &fg);
     let candidates: Vec<u32> = id
         .iter()
         .map(|&i| if holds_polarization[i as usize] { 0 } else { i })
@@ -441,13 +435,7 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
     if n == 0 {
         return Ok(fg);
     }
-    let outside = median(
-        ring(&hull, w, h, 1..=RING_FAR)
-            .into_iter()
-            .filter(|&k| cues.valid[k])
-            .map(|k| log_brightness(cues, k))
-            .collect(),
-    );
+    let outside = brightness_around(cues, &hull);
     let (owner, dist) = grow_labels(&id, w, h, RING_FAR, |_| true);
     let mut gap: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
     let mut object: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
@@ -476,6 +464,14 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
         })
         .collect();
     Ok((0..w * h).map(|k| fg[k] || fill[id[k] as usize]).collect())
+}
+
+/// The median log brightness of the valid pixels within [`RING_FAR`] steps outside `mask`:
+/// the background around the objects.
+fn brightness_around(cues: &Cues, mask: &[bool]) -> Option<f32> {
+    let ring = ring(mask, cues.width, cues.height, 1..=RING_FAR);
+    let valid = ring.into_iter().filter(|&k| cues.valid[k]);
+    median(valid.map(|k| log_brightness(cues, k)).collect())
 }
 
 /// A hole whose median log brightness is closer to the background's around the objects

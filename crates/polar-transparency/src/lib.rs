@@ -18,9 +18,10 @@
 //!
 //! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass. A
 //! region much darker than its surroundings is dropped ([`SEE_THROUGH`]: glass lets the
-//! background through); brighter ones neither segmenter tells apart reliably (docs/benchmarks.md measures the false
-//! positives on them; the kNN adds the polarization-difference contrast, the AoLP spread
-//! and intensity edges to the cues, [`knn::FEATURES`]).
+//! background through); brighter ones neither segmenter tells apart reliably
+//! (docs/benchmarks.md measures the false positives on them; the kNN adds the
+//! polarization-difference contrast, the AoLP spread and intensity edges to the cues,
+//! [`knn::FEATURES`]).
 //!
 //! [`detect`] runs one of two segmenters ([`Segmenter`]): the cue score above, which needs
 //! no training, or a k-nearest-neighbour classifier over per-pixel features built on the
