@@ -12,7 +12,9 @@
 //!   dielectric's specular reflection is polarized the same way.
 //!
 //! A region is dielectric when enough of its pixels pass the Fresnel cue or when its
-//! DoLP-weighted phase leans toward the azimuth; else metal (a metal never shows either).
+//! DoLP-weighted phase leans toward the azimuth, or when enough of its pixels see either
+//! in their own window (a mask may merge a dielectric with other objects); else metal (a
+//! metal never shows either).
 
 use crate::cues::Cues;
 use crate::features::Features;
@@ -41,6 +43,15 @@ const OVER_FRACTION: f32 = 0.06;
 const PHASE_LEAN: f32 = 0.0;
 /// Phase change that moves the phase cue by one unit of score.
 const PHASE_SCALE: f32 = 0.2;
+/// Share of a region's pixels with a dielectric in their own window at which a region the
+/// region-wide tallies vote metal is dielectric after all. An object mask can merge a
+/// dielectric with other objects and background, whose pixels dilute its cues in the
+/// region's sums; a metal shows the cues in a window only where noise or a normal error
+/// puts them, on a smaller share (Mitsuba 3's rough metals reach about a tenth).
+pub const LOCAL_EVIDENCE_SHARE: f32 = 0.15;
+/// Windowed dielectric score that counts as a dielectric seen in the window (a
+/// probability of metal of 0.2).
+const LOCAL_EVIDENCE_SCORE: f32 = 0.7;
 /// With measured normals, the phase cue uses only pixels seen beyond this zenith: nearer
 /// normal incidence diffuse polarization vanishes (it grows as `sin² θ`) and any
 /// specular reflection, a dielectric's included, sets the phase.
@@ -145,20 +156,49 @@ fn metal_from(score: f32) -> f32 {
 }
 
 /// Probability of metal per pixel (0.5 outside the object mask). With `smooth`, each
-/// region gets one value from its tallies; else each pixel from the tallies of the object
-/// pixels in a [`crate::features::WINDOW`]² window around it.
+/// region gets one value from its tallies, and a region voted metal is still dielectric
+/// when at least [`LOCAL_EVIDENCE_SHARE`] of its pixels see a dielectric in their own
+/// window ([`LOCAL_EVIDENCE_SCORE`]); without, each pixel gets the value of the tallies of
+/// the object pixels in a [`crate::features::WINDOW`]² window around it.
 pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, MaterialError> {
-    let (f, cues, fg) = (&p.features, &p.cues, &p.fg);
-    if smooth {
-        let metal: Vec<f32> = tallies(f, cues, &p.regions)
-            .iter()
-            .map(|t| metal_from(t.score()))
-            .collect();
-        let lab = &p.regions.labels;
+    let fg = &p.fg;
+    let local = windowed_scores(p)?;
+    if !smooth {
         return Ok(par_map(fg.len(), |k| {
-            if fg[k] { metal[lab[k] as usize] } else { 0.5 }
+            if fg[k] { metal_from(local[k]) } else { 0.5 }
         }));
     }
+    let regions = &p.regions;
+    let mut evidence = vec![[0.0f32; 2]; regions.count + 1];
+    for (k, &l) in regions.labels.iter().enumerate() {
+        if l != 0 {
+            let e = &mut evidence[l as usize];
+            e[0] += 1.0;
+            e[1] += f32::from(u8::from(local[k] >= LOCAL_EVIDENCE_SCORE));
+        }
+    }
+    let metal: Vec<f32> = tallies(&p.features, &p.cues, regions)
+        .iter()
+        .zip(&evidence)
+        .map(|(t, &[n, strong])| {
+            let score = t.score();
+            if score < 0.0 && strong >= LOCAL_EVIDENCE_SHARE * n {
+                metal_from(LOCAL_EVIDENCE_SCORE)
+            } else {
+                metal_from(score)
+            }
+        })
+        .collect();
+    let lab = &regions.labels;
+    Ok(par_map(fg.len(), |k| {
+        if fg[k] { metal[lab[k] as usize] } else { 0.5 }
+    }))
+}
+
+/// Per pixel, the dielectric score of the tallies of the object pixels in a
+/// [`crate::features::WINDOW`]² window around it (meaningless off the object mask).
+fn windowed_scores(p: &Prepared) -> Result<Vec<f32>, MaterialError> {
+    let (f, cues, fg) = (&p.features, &p.cues, &p.fg);
     let table = FresnelTable::new();
     let (w, h) = (f.width, f.height);
     let tally: Vec<Tally> = par_map(w * h, |j| {
@@ -182,15 +222,12 @@ pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, Materia
         plane(|t| t.rho)?,
     ];
     Ok(par_map(w * h, |j| {
-        if !fg[j] {
-            return 0.5;
-        }
-        let t = Tally {
+        Tally {
             valid: sums[0][j],
             over: sums[1][j],
             rho_phase: sums[2][j],
             rho: sums[3][j],
-        };
-        metal_from(t.score())
+        }
+        .score()
     }))
 }

@@ -285,3 +285,35 @@ fn size_mismatch_is_an_error() {
         .is_err()
     );
 }
+
+/// An object mask that merges a diffuse dielectric with a larger metal into one region
+/// (as a mask taking in touching objects does): the region-wide tallies vote metal, but
+/// the dielectric's own windows show its diffuse phase on more than
+/// `LOCAL_EVIDENCE_SHARE` of the region, so the region is dielectric. One region gets
+/// one label, so the aluminium goes with it: the price of the merged mask.
+#[test]
+fn dielectric_merged_into_a_metal_region_is_not_voted_down() {
+    let (obs, normals, mut fg) = scene([Surface::Diffuse(1.5), Surface::Specular(1.0, 6.6)]);
+    // Keep the dielectric's outer band (zenith above 40°) on the side of the metal only,
+    // a fifth of the region, and bridge the gap.
+    for y in 0..H {
+        for x in 0..W {
+            let k = y * W + x;
+            if let Some((0, ze, _)) = sphere_at(x, y) {
+                fg.as_mut_slice()[k] = u8::from(x >= 30 && ze > 0.7);
+            }
+            if (44..52).contains(&x) && (22..26).contains(&y) {
+                fg.as_mut_slice()[k] = 1;
+            }
+        }
+    }
+    let l = run(&obs, Some(&normals), Some(&fg));
+    let dielectric: usize = (0..W * H)
+        .filter(|&k| fg.as_slice()[k] != 0 && l.as_slice()[k] == DIELECTRIC)
+        .count();
+    let n = fg.as_slice().iter().filter(|&&v| v != 0).count();
+    assert_eq!(
+        dielectric, n,
+        "{dielectric} of the region's {n} pixels dielectric"
+    );
+}
