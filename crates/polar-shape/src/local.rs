@@ -29,8 +29,12 @@
 //!    ([`Prior::specular_rim`]: specular reflection dominates its light, as on glossy
 //!    plastic under a bright sky or on metal) the diffuse candidates pay the penalty
 //!    instead.
-//! 4. Output: `normalize(c n + (1 − c) field)` with `c` the polarization confidence, so
-//!    pixels without measurable polarization take their neighbours' shape.
+//! 4. Output: a pixel's chosen candidate where it lies within [`AGREEMENT_DEG`] of the
+//!    last field, else the field (the chosen candidates averaged with their confidences
+//!    over the field's window). A lone candidate carries its pixel's noise and, where it
+//!    won the choice by a small margin, possibly the wrong reflection type; the average
+//!    keeps what the neighbours agree on, and pixels without measurable polarization
+//!    take their neighbours' shape.
 //!
 //! Concave regions are recovered only where smoothness carries the DoLP/AoLP evidence
 //! against the convex prior (the prior is weak away from the contour).
@@ -46,6 +50,9 @@ use crate::{Estimate, ReflectionType, ShapeError};
 
 /// Cost of explaining a pixel without specular evidence by the specular model.
 pub const MIXED_PENALTY: f64 = 0.05;
+/// Largest angle (degrees) between a pixel's chosen candidate and the field at which the
+/// output keeps the candidate rather than the field.
+pub const AGREEMENT_DEG: f64 = 5.0;
 /// Gaussian sigma (pixels) of the smoothness field.
 const FIELD_SIGMA: f64 = 2.0;
 /// Weight of the boundary prior in the field.
@@ -96,28 +103,35 @@ pub fn disambiguate_with(cues: &Cues, fg: &[bool], prior: &Prior) -> Result<Esti
         });
         smooth_field(cues, fg, &chosen, prior, &mut planes, &mut field)?;
     }
-    let out: Vec<(Vector3<f64>, f32)> = (0..n)
+    let agreement = AGREEMENT_DEG.to_radians().cos();
+    let normals = (0..n)
+        .into_par_iter()
+        .map(|k| match chosen[k] {
+            (nc, kind, agree) if fg[k] && kind != ReflectionType::None && agree >= agreement => nc,
+            // The field, zero off the foreground (smooth_field).
+            _ => field[k],
+        })
+        .collect();
+    let confidence = (0..n)
         .into_par_iter()
         .map(|k| {
-            if !fg[k] {
-                return (Vector3::zeros(), 0.0);
-            }
-            let c = f64::from(cues.confidence[k]);
-            let (nc, kind, agree) = chosen[k];
-            let m = (nc * c + field[k] * (1.0 - c))
-                .try_normalize(1e-12)
-                .unwrap_or(field[k]);
+            let (_, kind, agree) = chosen[k];
             let penalty = if kind == ReflectionType::Mixed {
                 0.5
             } else {
                 1.0
             };
-            (m, (c * agree.max(0.0) * penalty) as f32)
+            let c = f64::from(cues.confidence[k]);
+            if fg[k] {
+                (c * agree.max(0.0) * penalty) as f32
+            } else {
+                0.0
+            }
         })
         .collect();
     Ok(Estimate {
-        normals: out.iter().map(|v| v.0).collect(),
-        confidence: out.iter().map(|v| v.1).collect(),
+        normals,
+        confidence,
         reflection: chosen.iter().map(|v| v.1).collect(),
         depth: None,
     })
