@@ -56,7 +56,10 @@
 //! instead (`crate::local`). Last, the gaps between a component and its convex hull that
 //! the component mostly borders and that are as bright as it are filled
 //! ([`fill_hull_gaps`]): a white object on a light floor is found as the open arcs of its
-//! rim, its face toward the camera too weakly polarized and edged for either cue.
+//! rim, its face toward the camera too weakly polarized and edged for either cue. Then
+//! the boundary pixels as bright as the background beside them rather than the object
+//! are given back to the background, twice ([`trim_boundary`]): the edges of A straddle
+//! the silhouette.
 //!
 //! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
 //! the view, a tiny image), every valid pixel is foreground: the frame shows one surface
@@ -139,6 +142,10 @@ const FACE_DOLP_FACTOR: f32 = 2.0;
 /// background, light reflected onto the floor by the objects counted as polarized and
 /// made faces of the floor in a torus's hole.
 const MIN_BACKGROUND_DOLP: f32 = 0.01;
+/// Passes of [`trim_boundary`] (each peels at most one pixel).
+const TRIM_PASSES: usize = 2;
+/// Half-width (pixels) of the window [`trim_boundary`] compares a boundary pixel in.
+const TRIM_RADIUS: usize = 2;
 
 /// Foreground mask (`true` on objects) of the cues (module doc).
 pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
@@ -171,6 +178,7 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         .collect();
     let fg = with_evidence(fg, &evidence, w, h)?;
     let fg = fill_hull_gaps(cues, fg)?;
+    let fg = (0..TRIM_PASSES).fold(fg, |fg, _| trim_boundary(cues, &fg));
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -464,6 +472,56 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
         })
         .collect();
     Ok((0..w * h).map(|k| fg[k] || fill[id[k] as usize]).collect())
+}
+
+/// `fg` without the boundary pixels (those with a 4-neighbour outside `fg`) whose log
+/// brightness is closer to the mean of the background's pixels than to the mean of the
+/// object's inner pixels in the (2 [`TRIM_RADIUS`] + 1)² window around them. Cue A's
+/// edges are a gradient response that straddles the silhouette and its regions include
+/// them, so the mask reaches about a pixel into the background; every such pixel moves
+/// the occluding contour outward and lowers the zeniths of the shape prior
+/// (`crate::local`). A pixel without valid neighbours on either side stays.
+pub(crate) fn trim_boundary(cues: &Cues, fg: &[bool]) -> Vec<bool> {
+    let (w, h) = (cues.width, cues.height);
+    let at = |x: usize, y: usize| fg[y * w + x];
+    let inner: Vec<bool> = (0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            fg[k]
+                && (x == 0 || at(x - 1, y))
+                && (x + 1 == w || at(x + 1, y))
+                && (y == 0 || at(x, y - 1))
+                && (y + 1 == h || at(x, y + 1))
+        })
+        .collect();
+    (0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            if !fg[k] || inner[k] || !cues.valid[k] {
+                return fg[k];
+            }
+            let (x, y) = (k % w, k / w);
+            // Sums and counts of log brightness: inner object pixels, background pixels.
+            let mut sums = [[0.0f32; 2]; 2];
+            for b in y.saturating_sub(TRIM_RADIUS)..(y + TRIM_RADIUS + 1).min(h) {
+                for a in x.saturating_sub(TRIM_RADIUS)..(x + TRIM_RADIUS + 1).min(w) {
+                    let j = b * w + a;
+                    if cues.valid[j] && (inner[j] || !fg[j]) {
+                        let side = &mut sums[usize::from(!fg[j])];
+                        side[0] += log_brightness(cues, j);
+                        side[1] += 1.0;
+                    }
+                }
+            }
+            let [[object, n_object], [background, n_background]] = sums;
+            if n_object == 0.0 || n_background == 0.0 {
+                return true;
+            }
+            let v = log_brightness(cues, k);
+            (v - object / n_object).abs() <= (v - background / n_background).abs()
+        })
+        .collect()
 }
 
 /// The median log brightness of the valid pixels within [`RING_FAR`] steps outside `mask`:

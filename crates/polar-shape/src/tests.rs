@@ -445,13 +445,13 @@ fn tiny_images() {
 #[test]
 fn resolution_independence() {
     // The sphere of `synthetic_sphere_end_to_end` seen by a camera with 8x finer pixels,
-    // each with polarization noise of DoLP up to 0.1 (the diffuse sphere's own DoLP is
+    // each with polarization noise of DoLP up to 0.2 (the diffuse sphere's own DoLP is
     // below 0.04 over most of its face). Worked on at the working scale (768 / 3 = 256
-    // pixels, a third of the noise) the errors are 3.0 degrees median, 4.5 mean; in the
-    // full 768 pixels the noise flips azimuths: 8.6 and 10.2. Bounds 4.5 and 7, and the
-    // full resolution at least 8 degrees mean, or the noise tests nothing.
+    // pixels, a third of the noise) the errors are 4.3 degrees median, 5.9 mean; in the
+    // full 768 pixels the noise flips azimuths: 12.1 and 12.8. Bounds 5.5 and 7.5, and the
+    // full resolution at least 10 degrees mean, or the noise tests nothing.
     let mut scene = sphere_scene(768, 1.5);
-    add_polarization_noise(&mut scene, 0.1);
+    add_polarization_noise(&mut scene, 0.2);
     let obs = scene.observation(1.0);
     let mask = scene.object_mask();
     let error = |working_size| {
@@ -465,11 +465,11 @@ fn resolution_independence() {
     };
     let (full, _) = error(0);
     assert!(
-        full.mean > 8.0,
+        full.mean > 10.0,
         "the noise is too weak to test anything: {full:?}"
     );
     let (err, shape) = error(crate::scale::WORKING_SIZE);
-    assert!(err.median < 4.5 && err.mean < 7.0, "{err:?}");
+    assert!(err.median < 5.5 && err.mean < 7.5, "{err:?}");
     let iou = polar_imgproc::iou(&shape.foreground, &mask)
         .unwrap()
         .unwrap();
@@ -1127,5 +1127,43 @@ fn face_between_rim_arcs_is_filled_floor_is_not() {
         assert_eq!(centre, filled, "face brightness {face}");
         // Nothing outside the disc is ever added.
         assert!((0..n * n).all(|k| !out[k] || inside(k % n, k / n).is_some() || arc(k % n, k / n)));
+    }
+}
+
+/// A disc on a floor, its mask grown by one pixel into the floor (as cue A's edges leave
+/// it): one pass of the boundary trim gives the floor pixels back, brighter or darker
+/// than the disc, and keeps every pixel of the disc.
+#[test]
+fn boundary_trim_gives_the_floor_ring_back() {
+    let n = 40;
+    let r = |x: usize, y: usize| (x as f64 + 0.5 - 20.0).hypot(y as f64 + 0.5 - 20.0);
+    let disc: Vec<bool> = (0..n * n).map(|k| r(k % n, k / n) < 10.0).collect();
+    let grown: Vec<bool> = (0..n * n)
+        .map(|k| {
+            let (x, y) = (k % n, k / n);
+            let (l, u) = (x.wrapping_sub(1), y.wrapping_sub(1));
+            [(x, y), (l, y), (x + 1, y), (x, u), (x, y + 1)]
+                .iter()
+                .any(|&(a, b)| a < n && b < n && disc[b * n + a])
+        })
+        .collect();
+    for (object, floor) in [(0.8f32, 0.2f32), (0.1, 0.6)] {
+        let obs = uniform_observation(n, n, [1.0, 0.0, 0.0], CameraModel::Orthographic);
+        let mut planes = obs.planes.clone();
+        for (k, s) in planes.s0.as_mut_slice().iter_mut().enumerate() {
+            *s = if disc[k] { object } else { floor };
+        }
+        let cues = Cues::new(&Observation::new(planes, CameraModel::Orthographic), 1.5).unwrap();
+        let out = crate::foreground::trim_boundary(&cues, &grown);
+        assert!(
+            disc.iter().zip(&out).all(|(&d, &o)| !d || o),
+            "a disc pixel was lost"
+        );
+        let ring_left = (0..n * n).filter(|&k| out[k] && !disc[k]).count();
+        let ring = (0..n * n).filter(|&k| grown[k] && !disc[k]).count();
+        assert!(
+            ring > 0 && ring_left == 0,
+            "{ring_left} of {ring} floor pixels kept"
+        );
     }
 }
