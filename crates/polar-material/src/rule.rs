@@ -51,7 +51,7 @@ const PHASE_SCALE: f32 = 0.2;
 pub const LOCAL_EVIDENCE_SHARE: f32 = 0.15;
 /// Windowed dielectric score that counts as a dielectric seen in the window (a
 /// probability of metal of 0.2).
-const LOCAL_EVIDENCE_SCORE: f32 = 0.7;
+pub const LOCAL_EVIDENCE_SCORE: f32 = 0.7;
 /// With measured normals, the phase cue uses only pixels seen beyond this zenith: nearer
 /// normal incidence diffuse polarization vanishes (it grows as `sin² θ`) and any
 /// specular reflection, a dielectric's included, sets the phase.
