@@ -178,7 +178,7 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
         .collect();
     let fg = with_evidence(fg, &evidence, w, h)?;
     let fg = fill_hull_gaps(cues, fg)?;
-    let fg = (0..TRIM_PASSES).fold(fg, |fg, _| trim_boundary(cues, &fg));
+    let fg = (0..TRIM_PASSES).try_fold(fg, |fg, _| trim_boundary(cues, &fg))?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -481,21 +481,10 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
 /// them, so the mask reaches about a pixel into the background; every such pixel moves
 /// the occluding contour outward and lowers the zeniths of the shape prior
 /// (`crate::local`). A pixel without valid neighbours on either side stays.
-pub(crate) fn trim_boundary(cues: &Cues, fg: &[bool]) -> Vec<bool> {
+pub(crate) fn trim_boundary(cues: &Cues, fg: &[bool]) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
-    let at = |x: usize, y: usize| fg[y * w + x];
-    let inner: Vec<bool> = (0..w * h)
-        .into_par_iter()
-        .map(|k| {
-            let (x, y) = (k % w, k / w);
-            fg[k]
-                && (x == 0 || at(x - 1, y))
-                && (x + 1 == w || at(x + 1, y))
-                && (y == 0 || at(x, y - 1))
-                && (y + 1 == h || at(x, y + 1))
-        })
-        .collect();
-    (0..w * h)
+    let inner = morph_mask(fg, w, h, Morph::ErodeCross)?;
+    Ok((0..w * h)
         .into_par_iter()
         .map(|k| {
             if !fg[k] || inner[k] || !cues.valid[k] {
@@ -521,7 +510,7 @@ pub(crate) fn trim_boundary(cues: &Cues, fg: &[bool]) -> Vec<bool> {
             let v = log_brightness(cues, k);
             (v - object / n_object).abs() <= (v - background / n_background).abs()
         })
-        .collect()
+        .collect())
 }
 
 /// The median log brightness of the valid pixels within [`RING_FAR`] steps outside `mask`:
@@ -580,15 +569,17 @@ fn border_regions(edges: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Shape
     Ok(fill_holes(edges, w, h)?.into_iter().map(|v| !v).collect())
 }
 
-/// A 3x3 square morphological operation on a mask.
+/// A 3x3 morphological operation on a mask: with a square, or erosion with a cross (the
+/// pixels whose 4-neighbours are all in the mask).
 #[derive(Clone, Copy)]
 enum Morph {
     Dilate,
     Erode,
+    ErodeCross,
     Open,
 }
 
-/// Applies `op` with a 3x3 square to a mask.
+/// Applies `op` (3x3) to a mask.
 fn morph_mask(mask: &[bool], w: usize, h: usize, op: Morph) -> Result<Vec<bool>, ShapeError> {
     let src = Gray::from_vec(
         w,
@@ -600,6 +591,7 @@ fn morph_mask(mask: &[bool], w: usize, h: usize, op: Morph) -> Result<Vec<bool>,
     match op {
         Morph::Dilate => dilate(&src, &mut dst, MorphShape::Rect, 3, 3)?,
         Morph::Erode => erode(&src, &mut dst, MorphShape::Rect, 3, 3)?,
+        Morph::ErodeCross => erode(&src, &mut dst, MorphShape::Cross, 3, 3)?,
         Morph::Open => open(&src, &mut dst, MorphShape::Rect, 3, 3)?,
     }
     Ok(dst.as_slice().par_iter().map(|&v| v > 0.5).collect())

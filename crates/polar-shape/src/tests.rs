@@ -1154,7 +1154,7 @@ fn boundary_trim_gives_the_floor_ring_back() {
             *s = if disc[k] { object } else { floor };
         }
         let cues = Cues::new(&Observation::new(planes, CameraModel::Orthographic), 1.5).unwrap();
-        let out = crate::foreground::trim_boundary(&cues, &grown);
+        let out = crate::foreground::trim_boundary(&cues, &grown).unwrap();
         assert!(
             disc.iter().zip(&out).all(|(&d, &o)| !d || o),
             "a disc pixel was lost"
