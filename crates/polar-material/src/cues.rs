@@ -28,7 +28,7 @@ pub struct Cues {
     pub phase_sin: Vec<f32>,
     /// Zenith angle of the normal from the view direction (radians); NaN where unknown.
     pub zenith: Vec<f32>,
-    /// `true` when `zenith` is the silhouette's sphere prior rather than measured.
+    /// `true` when `zenith` is the silhouette's sphere prior alone rather than measured.
     pub prior: bool,
 }
 
@@ -68,6 +68,26 @@ pub fn from_normals(
         zenith,
         prior: false,
     })
+}
+
+impl Cues {
+    /// Raises each measured zenith to the silhouette's sphere prior where that is larger
+    /// (and takes the prior where no normal is known). The shape task inverts a
+    /// dielectric's polarization model, so on a metal its zeniths come out far too small
+    /// (a metal's weak polarization reads as near-normal incidence), and a zenith too
+    /// small lowers the metal envelope under the metal's own DoLP. The prior errs the
+    /// other way (a face turned to the camera is read as turned away), which only makes
+    /// the Fresnel cue more cautious; it also lets the phase cue count the pixels it
+    /// puts near the occluding contour.
+    pub fn with_prior_floor(mut self, f: &Features, fg: &[bool], regions: &Regions) -> Self {
+        let prior = sphere_prior_zenith(fg, regions, f.width, f.height);
+        for (z, &p) in self.zenith.iter_mut().zip(&prior) {
+            if p.is_finite() && (z.is_nan() || *z < p) {
+                *z = p;
+            }
+        }
+        self
+    }
 }
 
 /// Half-width of the silhouette band, pixels.

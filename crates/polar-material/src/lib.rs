@@ -176,7 +176,8 @@ pub fn classify(
 }
 
 /// Features, object pixels (`foreground`, else [`foreground::estimate`]), their regions
-/// and cues (from `normals`, else from the silhouettes) of `obs`.
+/// and cues (from `normals`, with zeniths no smaller than the silhouettes' sphere prior,
+/// else from the silhouettes alone) of `obs`.
 pub fn prepare(
     obs: &Observation,
     normals: Option<&NormalImage>,
@@ -191,7 +192,9 @@ pub fn prepare(
     };
     let regions = Regions::new(&fg, size.0, size.1)?;
     let cues = match normals {
-        Some(n) => cues::from_normals(obs, &features, n)?,
+        Some(n) => {
+            cues::from_normals(obs, &features, n)?.with_prior_floor(&features, &fg, &regions)
+        }
         None => cues::from_silhouette(&features, &fg, &regions)?,
     };
     Ok(Prepared {

@@ -78,6 +78,30 @@ fn copper_stays_metal_with_zeniths_measured_too_small() {
     assert!(share(&l, 1, METAL) > 0.95, "{}", share(&l, 1, METAL));
 }
 
+/// On a metal the shape task's dielectric model reads the weak polarization as near
+/// normal incidence. With every measured zenith 5° (azimuths right), copper's DoLP toward
+/// its rim is far above the metal envelope there even with the margin; the silhouette's
+/// sphere prior, the floor of a measured zenith, keeps it metal, and the dielectric's
+/// DoLP near Brewster's angle still passes at the prior's zenith.
+#[test]
+fn copper_stays_metal_with_zeniths_measured_near_zero() {
+    let (obs, mut normals, fg) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.9, 2.6)]);
+    let (s, c) = 5f32.to_radians().sin_cos();
+    for n in normals.pixels_mut() {
+        let r = n[0].hypot(n[1]);
+        if n[2] > 0.0 && r > 0.0 {
+            *n = [n[0] / r * s, n[1] / r * s, c];
+        }
+    }
+    let l = run(&obs, Some(&normals), Some(&fg));
+    assert!(
+        share(&l, 0, DIELECTRIC) > 0.95,
+        "{}",
+        share(&l, 0, DIELECTRIC)
+    );
+    assert!(share(&l, 1, METAL) > 0.95, "{}", share(&l, 1, METAL));
+}
+
 /// A diffuse dielectric is weakly polarized (below the metal envelope) but along the
 /// azimuth: the silhouette phase cue must call it dielectric, the aluminium metal.
 #[test]
