@@ -18,12 +18,13 @@
 //!    dilation) and opened by 3×3 to drop thin edge lines;
 //! 4. of the edge-free interiors only object faces count ([`object_faces`]): those B
 //!    holds (a tenth of the ring around them is B: a face inside its coherent rim),
-//!    those polarized above the background (median DoLP twice the background's: a
-//!    glossy face whose AoLP varies too fast for B) and those whose rim shows the
-//!    occluding-contour signature below (a weakly polarized object); with the edges
-//!    near them or near B. Edges also enclose cast shadows and floor texture: they are
-//!    depolarized, their outline shows no contour, and B touches a shadow only along
-//!    its contact line with the object.
+//!    and those polarized above the background (median DoLP twice the background's: a
+//!    glossy face whose AoLP varies too fast for B); with the edges near them or near B.
+//!    Edges also enclose cast shadows and floor texture: they are no more polarized than
+//!    the floor, and B touches a shadow only along its contact line with the object. The
+//!    occluding-contour signature below is no test of a face: a floor tile whose edges
+//!    run along and across the floor's AoLP shows it too. A weakly polarized object
+//!    that neither cue holds is lost.
 //!
 //! **B. Coherently polarized regions** (for silhouettes too weak
 //! to be enclosed by A, e.g. a bright object on a bright floor):
@@ -122,10 +123,6 @@ const HOLE_ENCLOSURE: f64 = 0.9;
 /// a cast shadow touches B along its contact line with the object, a few percent of its
 /// ring (0.05-0.3 scored the same on the dev and Mitsuba sets).
 const HELD_BY_B: f64 = 0.1;
-/// Significance (standard deviations) of the occluding-contour signature that makes an
-/// interior B does not hold an object face (a weakly polarized object): lower than
-/// [`CONTOUR_SIGNIFICANCE`], as the rim is short and only this test speaks for it.
-const FACE_CONTOUR_SIGNIFICANCE: f64 = 2.0;
 /// Share of an edge-free interior that must be polarized (cue B or a polarized face) for
 /// the see-through test to leave it alone: cue B's window spills coherence from a
 /// torus's rim a few pixels into its depolarized hole, so a touch is not enough (0.1-0.3
@@ -294,8 +291,9 @@ struct Verdict {
 /// Per interior label of `id` (`n` labels; index 0 outside them): it is an object face
 /// when at least [`HELD_BY_B`] of the pixels within [`RING_FAR`] steps around it are B,
 /// when its median DoLP is above [`FACE_DOLP_FACTOR`] times the background's, taken as at
-/// least [`MIN_BACKGROUND_DOLP`] (then it is also `polarized`), or when its rim (the interior grown by [`EDGE_BAND`] steps through
-/// A) shows the occluding-contour signature at [`FACE_CONTOUR_SIGNIFICANCE`].
+/// least [`MIN_BACKGROUND_DOLP`] (then it is also `polarized`). The occluding-contour
+/// signature of its rim does not count: floor texture whose edges run along and across
+/// the floor's one AoLP shows it too.
 fn face_interiors(
     cues: &Cues,
     enclosed: &Enclosed,
@@ -323,9 +321,6 @@ fn face_interiors(
     for k in (0..w * h).filter(|&k| id[k] > 0 && cues.valid[k]) {
         dolp[id[k] as usize].push(cues.dolp[k]);
     }
-    let (rim_id, rim_dist) = grow_labels(id, w, h, EDGE_BAND, |k| enclosed.regions[k]);
-    let rim: Vec<bool> = rim_dist.iter().map(|&d| d != u32::MAX).collect();
-    let sums = contour_sums(cues, &rim, &rim_id, n)?;
     Ok((0..=n)
         .map(|c| {
             if c == 0 {
@@ -336,9 +331,8 @@ fn face_interiors(
                 (Some(d), Some(b)) if d > FACE_DOLP_FACTOR * b
             );
             let held = counts[c][1] as f64 >= HELD_BY_B * counts[c][0] as f64;
-            let contour = contour_above(sums[c], FACE_CONTOUR_SIGNIFICANCE);
             Verdict {
-                face: held || polarized || contour,
+                face: held || polarized,
                 polarized,
             }
         })
@@ -790,7 +784,7 @@ fn inner_or_with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeErro
         at_border[id[k] as usize] |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
     }
     let keep: Vec<bool> = (0..=n)
-        .map(|c| !at_border[c] || contour_above(sums[c], CONTOUR_SIGNIFICANCE))
+        .map(|c| !at_border[c] || has_contour(sums[c][0], sums[c][1], sums[c][2]))
         .collect();
     Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
 }
@@ -834,10 +828,5 @@ fn contour_sums(
 /// deviations of its value for independent random AoLP (`cos 4Δ` has mean 0 and
 /// variance ½, so the standard deviation is `√(Σρ²/2) / Σρ`).
 pub(crate) fn has_contour(weighted_cos: f64, weight: f64, weight_sq: f64) -> bool {
-    contour_above([weighted_cos, weight, weight_sq], CONTOUR_SIGNIFICANCE)
-}
-
-/// [`has_contour`] at `significance` standard deviations, from the three sums.
-fn contour_above([weighted_cos, weight, weight_sq]: [f64; 3], significance: f64) -> bool {
-    weight > 0.0 && weighted_cos > significance * (0.5 * weight_sq).sqrt()
+    weight > 0.0 && weighted_cos > CONTOUR_SIGNIFICANCE * (0.5 * weight_sq).sqrt()
 }

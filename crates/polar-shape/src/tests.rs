@@ -747,6 +747,45 @@ fn enclosed_floor_texture_without_polarization_is_not_foreground() {
     assert!(iou > 0.8, "sphere IoU {iou}");
 }
 
+/// A dark tile on a floor weakly polarized along one axis (a diffuse floor seen obliquely:
+/// DoLP 0.05, AoLP 0° everywhere). The tile's edges run parallel and perpendicular to that
+/// AoLP, so its rim shows the `cos 4Δ` signature of an occluding contour without being
+/// one: the interior the edges enclose is no object face (cue B lies far from it and it
+/// is no more polarized than the floor).
+#[test]
+fn floor_tile_aligned_with_the_floors_aolp_is_no_object_face() {
+    let (w, h) = (64, 64);
+    let tile = |x: usize, y: usize| (20..40).contains(&x) && (20..40).contains(&y);
+    let data = (0..w * h)
+        .flat_map(|k| {
+            let s0 = if tile(k % w, k / w) { 0.3 } else { 1.0 };
+            [s0, 0.05 * s0, 0.0]
+        })
+        .collect();
+    let img = LinearStokesImage::from_vec(w, h, data).unwrap();
+    let obs = Observation::new(
+        StokesPlanes::from_linear_stokes(&img),
+        CameraModel::Orthographic,
+    );
+    let cues = Cues::new(&obs, 1.5).unwrap();
+    let enclosed = crate::foreground::enclosed_by_edges(&cues).unwrap();
+    let inside = |k: usize| {
+        let (x, y) = (k % w, k / w);
+        (24..36).contains(&x) && (24..36).contains(&y)
+    };
+    assert!(
+        (0..w * h).filter(|&k| inside(k)).all(|k| enclosed.interiors[k]),
+        "the edges should enclose the tile"
+    );
+    // Cue B: a small blob in a corner, far from the tile.
+    let coherent: Vec<bool> = (0..w * h).map(|k| k % w < 6 && k / w < 6).collect();
+    let faces = crate::foreground::object_faces(&cues, enclosed, &coherent).unwrap();
+    let face = (0..w * h)
+        .filter(|&k| inside(k) && faces.enclosed.interiors[k])
+        .count();
+    assert_eq!(face, 0, "the tile taken for an object face");
+}
+
 /// A dark unpolarized patch on the floor touching the sphere (a cast shadow): edges
 /// enclose it together with the sphere, and cue B touches it along the contact line
 /// only, so it is not an object face and stays out; the sphere is kept.
