@@ -1,6 +1,7 @@
 //! Binary masks as `bool` planes (row-major, `w x h`): closing and opening (equal to the
-//! grey-scale operators on 0/1 images), hole filling and small-component removal with the labelling; the
-//! clean-up the segmenting tasks (material regions, transparency masks) share.
+//! grey-scale operators on 0/1 images), hole filling and small-component removal with the labelling,
+//! splitting at narrow necks; the clean-up the segmenting tasks (material regions,
+//! transparency masks) share.
 
 use crate::morph::{check_kernel, runs};
 use crate::{Connectivity, MorphShape, close, label, open};
@@ -114,6 +115,98 @@ pub fn components(m: &[bool], w: usize, h: usize) -> Result<(Vec<u32>, usize), E
     let mut lab = Gray::new(w, h);
     let n = label(&src, &mut lab, Connectivity::Eight)?;
     Ok((lab.into_vec(), n))
+}
+
+/// Splits a mask into its blobs: 8-connected regions of `m` cut where two blobs meet at a
+/// narrow neck. `dist` is any distance of each mask pixel to the outside (0 off the mask).
+/// Flooding the pixels from the largest distance down (union-find, as a watershed of
+/// `-dist` whose basins merge by their dynamics), two basins meeting at a pixel of
+/// distance `d` merge unless `d < neck * min(peak)` of the two basins' peaks and both
+/// peaks are at least `min_peak` (a bump of the outline is no blob); a pixel where they
+/// stay apart joins the basin of its farthest-inside neighbour. Returns per-pixel labels
+/// (`1..=count`, 0 off the mask) and the count.
+pub fn split_at_necks(
+    m: &[bool],
+    dist: &[f32],
+    w: usize,
+    h: usize,
+    neck: f32,
+    min_peak: f32,
+) -> (Vec<u32>, usize) {
+    let mut order: Vec<usize> = (0..w * h).filter(|&k| m[k]).collect();
+    order.sort_by(|&a, &b| dist[b].total_cmp(&dist[a]));
+    let mut parent: Vec<usize> = (0..w * h).collect();
+    let mut peak = vec![0.0f32; w * h];
+    let mut done = vec![false; w * h];
+    fn root(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
+        }
+        k
+    }
+    for &k in &order {
+        let (x, y) = ((k % w) as isize, (k / w) as isize);
+        let d = dist[k];
+        let mut best: Option<usize> = None;
+        let mut roots: Vec<usize> = Vec::with_capacity(8);
+        for (dx, dy) in [
+            (-1, -1),
+            (0, -1),
+            (1, -1),
+            (-1, 0),
+            (1, 0),
+            (-1, 1),
+            (0, 1),
+            (1, 1),
+        ] {
+            let (nx, ny) = (x + dx, y + dy);
+            if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
+                continue;
+            }
+            let j = ny as usize * w + nx as usize;
+            if !done[j] {
+                continue;
+            }
+            if best.is_none_or(|b| dist[j] > dist[b]) {
+                best = Some(j);
+            }
+            let r = root(&mut parent, j);
+            if !roots.contains(&r) {
+                roots.push(r);
+            }
+        }
+        done[k] = true;
+        let Some(b) = best else {
+            peak[k] = d;
+            continue;
+        };
+        let home = root(&mut parent, b);
+        parent[k] = home;
+        for r in roots {
+            let (a, r) = (root(&mut parent, home), root(&mut parent, r));
+            if a == r {
+                continue;
+            }
+            let low = peak[a].min(peak[r]);
+            if d >= neck * low || low < min_peak {
+                parent[r] = a;
+                peak[a] = peak[a].max(peak[r]);
+            }
+        }
+    }
+    let mut id = vec![0u32; w * h];
+    let mut count = 0usize;
+    let mut labels = vec![0u32; w * h];
+    for &k in &order {
+        let r = root(&mut parent, k);
+        if id[r] == 0 {
+            count += 1;
+            id[r] = count as u32;
+        }
+        labels[k] = id[r];
+    }
+    (labels, count)
 }
 
 /// Fills holes: components of the complement (4-connected) that do not touch the border.
@@ -272,6 +365,61 @@ pub fn clean(seed: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two discs of radius `r` at `x0` and `x1` on the middle row of a 64x32 mask, with a
+    /// bridge `half` pixels either side of that row between them, and the brute-force
+    /// Euclidean distance of each mask pixel to the nearest pixel off the mask.
+    fn two_discs(x0: f32, x1: f32, r: f32, half: usize) -> (Vec<bool>, Vec<f32>) {
+        let (w, h) = (64, 32);
+        let m: Vec<bool> = (0..w * h)
+            .map(|k| {
+                let (x, y) = ((k % w) as f32, (k / w) as f32);
+                let disc = |cx: f32| (x - cx).hypot(y - 16.0) <= r;
+                let bridge = x >= x0 && x <= x1 && (y - 16.0).abs() <= half as f32;
+                disc(x0) || disc(x1) || bridge
+            })
+            .collect();
+        let dist = (0..w * h)
+            .map(|k| {
+                if !m[k] {
+                    return 0.0;
+                }
+                let (x, y) = ((k % w) as f32, (k / w) as f32);
+                (0..w * h)
+                    .filter(|&j| !m[j])
+                    .map(|j| ((j % w) as f32 - x).hypot((j / w) as f32 - y))
+                    .fold(f32::INFINITY, f32::min)
+            })
+            .collect();
+        (m, dist)
+    }
+
+    /// Two discs of radius 10 joined by a 3-pixel bridge are two blobs, each disc one of
+    /// them; joined by a waist as wide as themselves, or overlapping, they are one.
+    #[test]
+    fn split_at_necks_cuts_a_bridge_not_a_waist() {
+        let (w, h) = (64, 32);
+        let (m, dist) = two_discs(16.0, 46.0, 10.0, 1);
+        let (labels, count) = split_at_necks(&m, &dist, w, h, 0.5, 3.0);
+        assert_eq!(count, 2);
+        let centre = |x: usize| labels[16 * w + x];
+        assert!(centre(16) != 0 && centre(46) != 0 && centre(16) != centre(46));
+        for k in (0..w * h).filter(|&k| m[k]) {
+            let x = (k % w) as f32;
+            if (x - 16.0).hypot((k / w) as f32 - 16.0) <= 8.0 {
+                assert_eq!(labels[k], centre(16), "pixel {k} left its disc");
+            }
+        }
+        assert!((0..w * h).all(|k| (labels[k] != 0) == m[k]));
+        for (x1, half) in [(46.0, 9), (26.0, 0)] {
+            let (m, dist) = two_discs(16.0, x1, 10.0, half);
+            assert_eq!(
+                split_at_necks(&m, &dist, w, h, 0.5, 3.0).1,
+                1,
+                "{x1} {half}"
+            );
+        }
+    }
 
     #[test]
     fn ring_hole_is_filled_and_border_gap_is_not() {

@@ -3,8 +3,9 @@
 //! - Fresnel cue (Wolff 1990): a DoLP above the largest specular DoLP a metal of
 //!   [`crate::fresnel_cues::METAL_INDICES`] reaches at that zenith cannot come from a
 //!   metal. The envelope is read [`MEASURED_MARGIN_DEG`] further toward grazing where
-//!   the zenith is the shape task's, [`PRIOR_MARGIN_DEG`] where it is the silhouette's
-//!   sphere prior (the envelope is a running maximum over the zenith), trading missed
+//!   the zenith is the shape task's (never less than the silhouette's sphere prior,
+//!   [`crate::cues::Cues::with_prior_floor`]), [`PRIOR_MARGIN_DEG`] where it is the
+//!   prior alone (the envelope is a running maximum over the zenith), trading missed
 //!   dielectrics for fewer false ones.
 //! - Phase cue: light polarized along the surface azimuth (phase `> 0`) is diffuse light
 //!   leaving a dielectric; metals have no diffuse lobe, so their light is polarized
@@ -14,13 +15,16 @@
 //! A region is dielectric when enough of its pixels pass the Fresnel cue or when its
 //! DoLP-weighted phase leans toward the azimuth, or when enough of its pixels see either
 //! in their own window (a mask may merge a dielectric with other objects); else metal (a
-//! metal never shows either).
+//! metal never shows either). A metal merged into a region voted dielectric is outvoted:
+//! the regions are split at narrow necks into blobs, and a blob that by itself shows no
+//! Fresnel evidence and light polarized clearly across the azimuth is metal.
 
 use crate::cues::Cues;
 use crate::features::Features;
 use crate::fresnel_cues::FresnelTable;
 use crate::{MaterialError, Prepared, Regions};
 use polar_image::{Gray, par_map};
+use polar_imgproc::mask::split_at_necks;
 use polar_imgproc::{Border, box_filter};
 
 /// DoLP margin above the metal envelope before the Fresnel cue fires (rendering or
@@ -52,6 +56,18 @@ pub const LOCAL_EVIDENCE_SHARE: f32 = 0.15;
 /// Windowed dielectric score that counts as a dielectric seen in the window (a
 /// probability of metal of 0.2).
 pub const LOCAL_EVIDENCE_SCORE: f32 = 0.7;
+/// A region is split into blobs where two meet at a neck narrower than this fraction of
+/// the smaller blob's inscribed radius (two touching objects; a bent one keeps a waist
+/// wider than that).
+const NECK_RATIO: f32 = 0.5;
+/// Inscribed radius (pixels) below which a blob is a bump of the outline, not an object.
+const MIN_BLOB_RADIUS: f32 = 3.0;
+/// Largest share of a blob's pixels above the metal envelope for it to show no Fresnel
+/// evidence.
+const BLOB_MAX_OVER: f32 = 0.01;
+/// DoLP-weighted phase below which a blob's light is clearly polarized across the
+/// azimuth, as a metal's (a specular-dominated dielectric's also leans that way, less).
+const BLOB_METAL_PHASE: f32 = -0.55;
 /// With measured normals, the phase cue uses only pixels seen beyond this zenith: nearer
 /// normal incidence diffuse polarization vanishes (it grows as `sin² θ`) and any
 /// specular reflection, a dielectric's included, sets the phase.
@@ -189,10 +205,43 @@ pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, Materia
             }
         })
         .collect();
+    let merged = merged_metal(p, &metal);
     let lab = &regions.labels;
-    Ok(par_map(fg.len(), |k| {
-        if fg[k] { metal[lab[k] as usize] } else { 0.5 }
+    Ok(par_map(fg.len(), |k| match (fg[k], merged[k]) {
+        (false, _) => 0.5,
+        (true, m) if m.is_finite() => m,
+        (true, _) => metal[lab[k] as usize],
     }))
+}
+
+/// Probability of metal per pixel of the blobs (the object regions split at necks,
+/// [`split_at_necks`]) that lie in a region voted dielectric (`region_metal < 0.5`) and
+/// show a metal by themselves: at most [`BLOB_MAX_OVER`] of their pixels above the metal
+/// envelope and a DoLP-weighted phase below [`BLOB_METAL_PHASE`]. NaN elsewhere.
+fn merged_metal(p: &Prepared, region_metal: &[f32]) -> Vec<f32> {
+    let (w, h) = (p.features.width, p.features.height);
+    let dist = crate::cues::chamfer_distance(&p.fg, w, h);
+    let (labels, count) = split_at_necks(&p.fg, &dist, w, h, NECK_RATIO, MIN_BLOB_RADIUS);
+    let blobs = Regions { labels, count };
+    let metal: Vec<f32> = tallies(&p.features, &p.cues, &blobs)
+        .iter()
+        .map(|t| {
+            let [over, phase] = t.region_cues();
+            if t.rho > 0.0 && over < BLOB_MAX_OVER && phase < BLOB_METAL_PHASE {
+                metal_from(t.score())
+            } else {
+                f32::NAN
+            }
+        })
+        .collect();
+    let region = &p.regions.labels;
+    par_map(w * h, |k| {
+        if region_metal[region[k] as usize] < 0.5 {
+            metal[blobs.labels[k] as usize]
+        } else {
+            f32::NAN
+        }
+    })
 }
 
 /// Per pixel, the dielectric score of the tallies of the object pixels in a

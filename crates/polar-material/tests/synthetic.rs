@@ -102,6 +102,27 @@ fn copper_stays_metal_with_zeniths_measured_near_zero() {
     assert!(share(&l, 1, METAL) > 0.95, "{}", share(&l, 1, METAL));
 }
 
+/// An object mask that merges a gold sphere with a dielectric one (a bridge of floor
+/// pixels between them): the dielectric's Fresnel evidence votes the whole region
+/// dielectric, but split at the bridge the gold blob shows no Fresnel evidence and its
+/// light is polarized across the azimuth, so it is metal. With the silhouette's cues and
+/// with the true normals.
+#[test]
+fn gold_merged_with_a_dielectric_stays_metal() {
+    let (obs, normals, mut fg) =
+        scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+    for y in 22..27 {
+        for x in 40..57 {
+            fg.as_mut_slice()[y * W + x] = 1;
+        }
+    }
+    for n in [None, Some(&normals)] {
+        let l = run(&obs, n, Some(&fg));
+        let (d, m) = (share(&l, 0, DIELECTRIC), share(&l, 1, METAL));
+        assert!(d > 0.95 && m > 0.95, "normals {}: {d} {m}", n.is_some());
+    }
+}
+
 /// A diffuse dielectric is weakly polarized (below the metal envelope) but along the
 /// azimuth: the silhouette phase cue must call it dielectric, the aluminium metal.
 #[test]

@@ -774,7 +774,9 @@ fn floor_tile_aligned_with_the_floors_aolp_is_no_object_face() {
         (24..36).contains(&x) && (24..36).contains(&y)
     };
     assert!(
-        (0..w * h).filter(|&k| inside(k)).all(|k| enclosed.interiors[k]),
+        (0..w * h)
+            .filter(|&k| inside(k))
+            .all(|k| enclosed.interiors[k]),
         "the edges should enclose the tile"
     );
     // Cue B: a small blob in a corner, far from the tile.
