@@ -134,7 +134,8 @@ pub fn split_at_necks(
     min_peak: f32,
 ) -> (Vec<u32>, usize) {
     let mut order: Vec<usize> = (0..w * h).filter(|&k| m[k]).collect();
-    order.sort_by(|&a, &b| dist[b].total_cmp(&dist[a]));
+    // Farthest inside first, ties in raster order.
+    order.sort_unstable_by(|&a, &b| dist[b].total_cmp(&dist[a]).then(a.cmp(&b)));
     let mut parent: Vec<usize> = (0..w * h).collect();
     let mut peak = vec![0.0f32; w * h];
     let mut done = vec![false; w * h];
@@ -149,7 +150,7 @@ pub fn split_at_necks(
         let (x, y) = ((k % w) as isize, (k / w) as isize);
         let d = dist[k];
         let mut best: Option<usize> = None;
-        let mut roots: Vec<usize> = Vec::with_capacity(8);
+        let (mut roots, mut n_roots) = ([0usize; 8], 0);
         for (dx, dy) in [
             (-1, -1),
             (0, -1),
@@ -172,8 +173,9 @@ pub fn split_at_necks(
                 best = Some(j);
             }
             let r = root(&mut parent, j);
-            if !roots.contains(&r) {
-                roots.push(r);
+            if !roots[..n_roots].contains(&r) {
+                roots[n_roots] = r;
+                n_roots += 1;
             }
         }
         done[k] = true;
@@ -183,7 +185,7 @@ pub fn split_at_necks(
         };
         let home = root(&mut parent, b);
         parent[k] = home;
-        for r in roots {
+        for &r in &roots[..n_roots] {
             let (a, r) = (root(&mut parent, home), root(&mut parent, r));
             if a == r {
                 continue;

@@ -220,8 +220,12 @@ pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, Materia
 /// envelope and a DoLP-weighted phase below [`BLOB_METAL_PHASE`]. NaN elsewhere.
 fn merged_metal(p: &Prepared, region_metal: &[f32]) -> Vec<f32> {
     let (w, h) = (p.features.width, p.features.height);
-    let dist = crate::cues::chamfer_distance(&p.fg, w, h);
-    let (labels, count) = split_at_necks(&p.fg, &dist, w, h, NECK_RATIO, MIN_BLOB_RADIUS);
+    let region = &p.regions.labels;
+    // Only the regions voted dielectric; whole regions, so the distances are unchanged.
+    let voted_dielectric = |k: usize| region_metal[region[k] as usize] < 0.5;
+    let m: Vec<bool> = (0..w * h).map(|k| p.fg[k] && voted_dielectric(k)).collect();
+    let dist = crate::cues::chamfer_distance(&m, w, h);
+    let (labels, count) = split_at_necks(&m, &dist, w, h, NECK_RATIO, MIN_BLOB_RADIUS);
     let blobs = Regions { labels, count };
     let metal: Vec<f32> = tallies(&p.features, &p.cues, &blobs)
         .iter()
@@ -234,9 +238,8 @@ fn merged_metal(p: &Prepared, region_metal: &[f32]) -> Vec<f32> {
             }
         })
         .collect();
-    let region = &p.regions.labels;
     par_map(w * h, |k| {
-        if region_metal[region[k] as usize] < 0.5 {
+        if m[k] {
             metal[blobs.labels[k] as usize]
         } else {
             f32::NAN
