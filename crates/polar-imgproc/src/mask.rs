@@ -136,79 +136,95 @@ pub fn split_at_necks(
     let mut order: Vec<usize> = (0..w * h).filter(|&k| m[k]).collect();
     // Farthest inside first, ties in raster order.
     order.sort_unstable_by(|&a, &b| dist[b].total_cmp(&dist[a]).then(a.cmp(&b)));
-    let mut parent: Vec<usize> = (0..w * h).collect();
-    let mut peak = vec![0.0f32; w * h];
-    let mut done = vec![false; w * h];
-    fn root(parent: &mut [usize], mut k: usize) -> usize {
-        while parent[k] != k {
-            parent[k] = parent[parent[k]];
-            k = parent[k];
+    let mut flood = Flood {
+        parent: (0..w * h).collect(),
+        peak: vec![0.0; w * h],
+        done: vec![false; w * h],
+    };
+    for &k in &order {
+        flood.add(k, dist, w, h, |d, low| d >= neck * low || low < min_peak);
+    }
+    flood.labels(&order)
+}
+
+/// The union-find state of [`split_at_necks`]: each pixel's parent, each basin root's
+/// peak distance, and which pixels are flooded.
+struct Flood {
+    parent: Vec<usize>,
+    peak: Vec<f32>,
+    done: Vec<bool>,
+}
+
+impl Flood {
+    /// The root of `k`'s basin (path halving).
+    fn root(&mut self, mut k: usize) -> usize {
+        while self.parent[k] != k {
+            self.parent[k] = self.parent[self.parent[k]];
+            k = self.parent[k];
         }
         k
     }
-    for &k in &order {
-        let (x, y) = ((k % w) as isize, (k / w) as isize);
-        let d = dist[k];
+
+    /// Floods pixel `k` of distance `dist[k]`: a new basin if no 8-neighbour is flooded,
+    /// else it joins its farthest-inside neighbour's basin, and the basins it touches
+    /// merge where `merge(dist[k], smaller peak)` holds.
+    fn add(
+        &mut self,
+        k: usize,
+        dist: &[f32],
+        w: usize,
+        h: usize,
+        merge: impl Fn(f32, f32) -> bool,
+    ) {
+        let (x, y) = (k % w, k / w);
         let mut best: Option<usize> = None;
         let (mut roots, mut n_roots) = ([0usize; 8], 0);
-        for (dx, dy) in [
-            (-1, -1),
-            (0, -1),
-            (1, -1),
-            (-1, 0),
-            (1, 0),
-            (-1, 1),
-            (0, 1),
-            (1, 1),
-        ] {
-            let (nx, ny) = (x + dx, y + dy);
-            if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
-                continue;
-            }
-            let j = ny as usize * w + nx as usize;
-            if !done[j] {
-                continue;
-            }
-            if best.is_none_or(|b| dist[j] > dist[b]) {
-                best = Some(j);
-            }
-            let r = root(&mut parent, j);
-            if !roots[..n_roots].contains(&r) {
-                roots[n_roots] = r;
-                n_roots += 1;
+        for ny in y.saturating_sub(1)..=(y + 1).min(h - 1) {
+            for nx in x.saturating_sub(1)..=(x + 1).min(w - 1) {
+                let j = ny * w + nx;
+                if !self.done[j] {
+                    continue;
+                }
+                if best.is_none_or(|b| dist[j] > dist[b]) {
+                    best = Some(j);
+                }
+                let r = self.root(j);
+                if !roots[..n_roots].contains(&r) {
+                    roots[n_roots] = r;
+                    n_roots += 1;
+                }
             }
         }
-        done[k] = true;
+        self.done[k] = true;
         let Some(b) = best else {
-            peak[k] = d;
-            continue;
+            self.peak[k] = dist[k];
+            return;
         };
-        let home = root(&mut parent, b);
-        parent[k] = home;
+        let home = self.root(b);
+        self.parent[k] = home;
         for &r in &roots[..n_roots] {
-            let (a, r) = (root(&mut parent, home), root(&mut parent, r));
-            if a == r {
-                continue;
-            }
-            let low = peak[a].min(peak[r]);
-            if d >= neck * low || low < min_peak {
-                parent[r] = a;
-                peak[a] = peak[a].max(peak[r]);
+            let (a, r) = (self.root(home), self.root(r));
+            if a != r && merge(dist[k], self.peak[a].min(self.peak[r])) {
+                self.parent[r] = a;
+                self.peak[a] = self.peak[a].max(self.peak[r]);
             }
         }
     }
-    let mut id = vec![0u32; w * h];
-    let mut count = 0usize;
-    let mut labels = vec![0u32; w * h];
-    for &k in &order {
-        let r = root(&mut parent, k);
-        if id[r] == 0 {
-            count += 1;
-            id[r] = count as u32;
+
+    /// Labels `1..=count` of the basins of the flooded pixels `order` (0 elsewhere).
+    fn labels(&mut self, order: &[usize]) -> (Vec<u32>, usize) {
+        let n = self.parent.len();
+        let (mut id, mut labels, mut count) = (vec![0u32; n], vec![0u32; n], 0usize);
+        for &k in order {
+            let r = self.root(k);
+            if id[r] == 0 {
+                count += 1;
+                id[r] = count as u32;
+            }
+            labels[k] = id[r];
         }
-        labels[k] = id[r];
+        (labels, count)
     }
-    (labels, count)
 }
 
 /// Fills holes: components of the complement (4-connected) that do not touch the border.
