@@ -124,7 +124,8 @@ pub fn components(m: &[bool], w: usize, h: usize) -> Result<(Vec<u32>, usize), E
 /// distance `d` merge unless `d < neck * min(peak)` of the two basins' peaks and both
 /// peaks are at least `min_peak` (a bump of the outline is no blob); a pixel where they
 /// stay apart joins the basin of its farthest-inside neighbour. Returns per-pixel labels
-/// (`1..=count`, 0 off the mask) and the count.
+/// (`1..=count`, 0 off the mask) and the count; an error if `m` or `dist` is not `w x h`
+/// or a mask pixel's distance is not finite.
 pub fn split_at_necks(
     m: &[bool],
     dist: &[f32],
@@ -132,8 +133,16 @@ pub fn split_at_necks(
     h: usize,
     neck: f32,
     min_peak: f32,
-) -> (Vec<u32>, usize) {
+) -> Result<(Vec<u32>, usize), Error> {
+    for len in [m.len(), dist.len()] {
+        if len != w * h {
+            return Err(Error::SizeMismatch(w, h, len, 1));
+        }
+    }
     let mut order: Vec<usize> = (0..w * h).filter(|&k| m[k]).collect();
+    if order.iter().any(|&k| !dist[k].is_finite()) {
+        return Err(Error::NonFinite);
+    }
     // Farthest inside first, ties in raster order.
     order.sort_unstable_by(|&a, &b| dist[b].total_cmp(&dist[a]).then(a.cmp(&b)));
     let mut flood = Flood {
@@ -144,7 +153,7 @@ pub fn split_at_necks(
     for &k in &order {
         flood.add(k, dist, w, h, |d, low| d >= neck * low || low < min_peak);
     }
-    flood.labels(&order)
+    Ok(flood.labels(&order))
 }
 
 /// The union-find state of [`split_at_necks`]: each pixel's parent, each basin root's
@@ -418,7 +427,7 @@ mod tests {
     fn split_at_necks_cuts_a_bridge_not_a_waist() {
         let (w, h) = (64, 32);
         let (m, dist) = two_discs(16.0, 46.0, 10.0, 1);
-        let (labels, count) = split_at_necks(&m, &dist, w, h, 0.5, 3.0);
+        let (labels, count) = split_at_necks(&m, &dist, w, h, 0.5, 3.0).unwrap();
         assert_eq!(count, 2);
         let centre = |x: usize| labels[16 * w + x];
         assert!(centre(16) != 0 && centre(46) != 0 && centre(16) != centre(46));
@@ -432,11 +441,27 @@ mod tests {
         for (x1, half) in [(46.0, 9), (26.0, 0)] {
             let (m, dist) = two_discs(16.0, x1, 10.0, half);
             assert_eq!(
-                split_at_necks(&m, &dist, w, h, 0.5, 3.0).1,
+                split_at_necks(&m, &dist, w, h, 0.5, 3.0).unwrap().1,
                 1,
                 "{x1} {half}"
             );
         }
+    }
+
+    /// A distance plane of the wrong size or a non-finite distance on the mask is an
+    /// error, not a panic or a silently odd split.
+    #[test]
+    fn split_at_necks_rejects_bad_input() {
+        let (m, mut dist) = two_discs(16.0, 46.0, 10.0, 1);
+        assert!(matches!(
+            split_at_necks(&m, &dist[1..], 64, 32, 0.5, 3.0),
+            Err(Error::SizeMismatch(..))
+        ));
+        dist[16 * 64 + 16] = f32::NAN;
+        assert!(matches!(
+            split_at_necks(&m, &dist, 64, 32, 0.5, 3.0),
+            Err(Error::NonFinite)
+        ));
     }
 
     #[test]

@@ -205,7 +205,7 @@ pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, Materia
             }
         })
         .collect();
-    let merged = merged_metal(p, &metal);
+    let merged = merged_metal(p, &metal)?;
     let lab = &regions.labels;
     Ok(par_map(fg.len(), |k| match (fg[k], merged[k]) {
         (false, _) => 0.5,
@@ -218,14 +218,14 @@ pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, Materia
 /// [`split_at_necks`]) that lie in a region voted dielectric (`region_metal < 0.5`) and
 /// show a metal by themselves: at most [`BLOB_MAX_OVER`] of their pixels above the metal
 /// envelope and a DoLP-weighted phase below [`BLOB_METAL_PHASE`]. NaN elsewhere.
-fn merged_metal(p: &Prepared, region_metal: &[f32]) -> Vec<f32> {
+fn merged_metal(p: &Prepared, region_metal: &[f32]) -> Result<Vec<f32>, MaterialError> {
     let (w, h) = (p.features.width, p.features.height);
     let region = &p.regions.labels;
     // Only the regions voted dielectric; whole regions, so the distances are unchanged.
     let voted_dielectric = |k: usize| region_metal[region[k] as usize] < 0.5;
     let m: Vec<bool> = (0..w * h).map(|k| p.fg[k] && voted_dielectric(k)).collect();
     let dist = crate::cues::chamfer_distance(&m, w, h);
-    let (labels, count) = split_at_necks(&m, &dist, w, h, NECK_RATIO, MIN_BLOB_RADIUS);
+    let (labels, count) = split_at_necks(&m, &dist, w, h, NECK_RATIO, MIN_BLOB_RADIUS)?;
     let blobs = Regions { labels, count };
     let metal: Vec<f32> = tallies(&p.features, &p.cues, &blobs)
         .iter()
@@ -238,13 +238,13 @@ fn merged_metal(p: &Prepared, region_metal: &[f32]) -> Vec<f32> {
             }
         })
         .collect();
-    par_map(w * h, |k| {
+    Ok(par_map(w * h, |k| {
         if m[k] {
             metal[blobs.labels[k] as usize]
         } else {
             f32::NAN
         }
-    })
+    }))
 }
 
 /// Per pixel, the dielectric score of the tallies of the object pixels in a
