@@ -2,10 +2,11 @@
 //! vectors that training and inference both compute one way ([`pixel_features`]).
 //!
 //! Every feature is scale-free (S0 enters only divided by the frame's robust scale) and
-//! computed with the silhouette cues (the same at training and inference: the zenith is
-//! the sphere prior and the phase is measured against the silhouette's outward normal).
+//! computed with the cues of [`crate::prepare`]: from the normals and object mask of shape
+//! from polarization where given, as `polar-vision train` gives them at training and `run`
+//! at inference, else from the silhouettes (a shift from how the shipped model was trained).
 
-use polar_image::{Gray, par_map};
+use polar_image::{Gray, NormalImage, par_map};
 use polar_imgproc::{Border, box_filter};
 use polar_learn::{Expect, Knn};
 use polar_sensor::Observation;
@@ -22,10 +23,10 @@ pub const DIMS: usize = 10;
 /// The ordered feature list, written into every model file:
 /// - `dolp`: windowed DoLP;
 /// - `s0_relative`: windowed S0 over the frame's 99th percentile (albedo, exposure-free);
-/// - `phase_cos`, `phase_sin`: `cos 2δ`, `sin 2δ` with `δ` = AoLP − silhouette azimuth
-///   (0 where unknown, inside the objects);
-/// - `fresnel_excess`: DoLP minus the largest metal specular DoLP at the sphere prior's
-///   zenith (Wolff's cue; positive only a dielectric can reach);
+/// - `phase_cos`, `phase_sin`: `cos 2δ`, `sin 2δ` with `δ` = AoLP − the cues' azimuth
+///   (0 where unknown);
+/// - `fresnel_excess`: DoLP minus the largest metal specular DoLP at the cues' zenith
+///   (Wolff's cue; positive only a dielectric can reach);
 /// - `dolp_local_mean`, `dolp_local_sd`: DoLP statistics over a [`LOCAL`]² window;
 /// - `region_over`, `region_phase`: the physics rule's evidence over the pixel's connected
 ///   object region ([`crate::rule::region_cues`]);
@@ -213,17 +214,19 @@ pub fn metal_probability(
 }
 
 /// Training points of one labelled frame: the feature vectors of the valid pixels that
-/// [`crate::classify`] with this classifier would see as object and `labels` (as in
-/// `gt/material.png`) marks dielectric or metal, with their class indices. Appends to
-/// `points` (row-major) and `classes`.
+/// [`crate::classify`] with this classifier and the same `normals` and `foreground` would
+/// see as object and `labels` (as in `gt/material.png`) marks dielectric or metal, with
+/// their class indices. Appends to `points` (row-major) and `classes`.
 pub fn add_training_pixels(
     obs: &Observation,
+    normals: Option<&NormalImage>,
+    foreground: Option<&Gray<u8>>,
     labels: &Gray<u8>,
     points: &mut Vec<f32>,
     classes: &mut Vec<u8>,
 ) -> Result<(), MaterialError> {
     crate::check_size("labels", obs.size(), Some(labels.size()))?;
-    let p = crate::prepare(obs, None, None)?;
+    let p = crate::prepare(obs, normals, foreground)?;
     let x = FrameFeatures::new(&p)?;
     for (k, &l) in labels.as_slice().iter().enumerate() {
         if p.fg[k] && p.features.valid[k] && (l == DIELECTRIC || l == METAL) {

@@ -91,8 +91,8 @@ impl Regions {
 pub enum Classifier {
     /// The training-free Fresnel / AoLP-phase rule of [`rule`].
     Physics,
-    /// k nearest neighbours over [`knn::FEATURES`] from a trained model file; it uses the
-    /// silhouette cues it was trained with, never the given normals.
+    /// k nearest neighbours over [`knn::FEATURES`] from a trained model file, computed
+    /// from the same cues as the rule's.
     Knn(Arc<knn::KnnClassifier>),
 }
 
@@ -125,8 +125,8 @@ pub struct MaterialMap {
 ///
 /// `normals`: camera-frame unit normals (e.g. from shape from polarization; `(0,0,0)` =
 /// unknown) give the zenith and azimuth at every pixel; without them the azimuth is taken
-/// from the object silhouettes (the kNN always takes them from the silhouettes, as it was
-/// trained). `foreground`: non-zero on object pixels; without it
+/// from the object silhouettes (for the kNN, give what its model was trained with:
+/// `polar-vision train` runs shape from polarization). `foreground`: non-zero on object pixels; without it
 /// [`foreground::estimate`] decides. `transparent`: non-zero on transparent pixels, which
 /// are labelled [`TRANSPARENT`] over the opaque classification. They stay in the object
 /// regions it classifies: the edge of a transparency mask is no occluding contour, and
@@ -140,10 +140,6 @@ pub fn classify(
     clf: &Classifier,
     opts: &MaterialOptions,
 ) -> Result<MaterialMap, MaterialError> {
-    let normals = match clf {
-        Classifier::Physics => normals,
-        Classifier::Knn(_) => None,
-    };
     check_size("transparent", obs.size(), transparent.map(|m| m.size()))?;
     let p = prepare(obs, normals, foreground)?;
     let smooth = opts.smooth_regions;

@@ -2,7 +2,7 @@
 //! unpolarized floor): its features' scale invariance, and training on one scene then
 //! classifying another with other indices and the materials swapped.
 
-use polar_image::Gray;
+use polar_image::{Gray, NormalImage};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -60,17 +60,16 @@ fn features_are_scale_invariant_times_7() {
     assert!(informative > 500, "{informative}");
 }
 
-/// Trained on a glass-like specular sphere (n = 1.5) and a gold one, the kNN labels a
-/// scene with the materials swapped in place and other indices (n = 1.6, silver) right:
-/// region smoothing makes each sphere one label, so the shares are 0 or 1; 0.95 leaves
-/// room for rim pixels the window blurs.
-#[test]
-fn knn_trained_on_one_scene_labels_another() {
-    let (train, _, _) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+/// A kNN (k = 5) trained on the spheres of `surfaces` labelled `labels`, with the scene's
+/// true normals and mask where `with_normals`.
+fn trained(surfaces: [Surface; 2], labels: [u8; 2], with_normals: bool) -> Classifier {
+    let (train, normals, fg) = scene(surfaces);
     let (mut points, mut classes) = (Vec::new(), Vec::new());
     knn::add_training_pixels(
         &train,
-        &truth([DIELECTRIC, METAL]),
+        with_normals.then_some(&normals),
+        with_normals.then_some(&fg),
+        &truth(labels),
         &mut points,
         &mut classes,
     )
@@ -87,23 +86,58 @@ fn knn_trained_on_one_scene_labels_another() {
     )
     .unwrap();
     assert!(model.labels.len() <= 1000);
-    let clf = Classifier::Knn(Arc::new(
+    Classifier::Knn(Arc::new(
         KnnClassifier::new(model, Path::new("mem")).unwrap(),
-    ));
-    let (test, _, _) = scene([Surface::Specular(0.06, 3.586), Surface::Specular(1.6, 0.0)]);
-    let labels = classify(&test, None, None, None, &clf, &MaterialOptions::default())
+    ))
+}
+
+/// The training scene of the two tests below: a glass-like specular sphere (n = 1.5) and
+/// a gold one.
+const TRAIN: [Surface; 2] = [Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)];
+/// The test scene: the materials swapped in place, other indices (silver, n = 1.6).
+const TEST: [Surface; 2] = [Surface::Specular(0.06, 3.586), Surface::Specular(1.6, 0.0)];
+
+/// Asserts sphere 0 reads metal and sphere 1 dielectric: region smoothing makes each
+/// sphere one label, so the shares are 0 or 1; 0.95 leaves room for rim pixels the window
+/// blurs.
+fn assert_swapped_scene_right(labels: &Gray<u8>) {
+    let (metal, dielectric) = (share(labels, 0, METAL), share(labels, 1, DIELECTRIC));
+    assert!(metal > 0.95 && dielectric > 0.95, "{metal} {dielectric}");
+}
+
+/// Trained on one scene, the kNN labels the other right.
+#[test]
+fn knn_trained_on_one_scene_labels_another() {
+    let clf = trained(TRAIN, [DIELECTRIC, METAL], false);
+    let (test, _, _) = scene(TEST);
+    let opts = MaterialOptions::default();
+    let labels = classify(&test, None, None, None, &clf, &opts)
         .unwrap()
         .labels;
-    assert!(
-        share(&labels, 0, METAL) > 0.95,
-        "{}",
-        share(&labels, 0, METAL)
-    );
-    assert!(
-        share(&labels, 1, DIELECTRIC) > 0.95,
-        "{}",
-        share(&labels, 1, DIELECTRIC)
-    );
+    assert_swapped_scene_right(&labels);
+}
+
+/// Trained and run with the normals and mask given (as shape from polarization gives them
+/// in `polar-vision train` and `run`), the kNN labels the other scene right; and it reads
+/// its cues from the normals: the shipped model's confidences with them differ from those
+/// with the silhouette cues.
+#[test]
+fn knn_reads_the_given_normals() {
+    let clf = trained(TRAIN, [DIELECTRIC, METAL], true);
+    let (test, normals, fg) = scene(TEST);
+    let opts = MaterialOptions::default();
+    let given = classify(&test, Some(&normals), Some(&fg), None, &clf, &opts).unwrap();
+    assert_swapped_scene_right(&given.labels);
+    let builtin =
+        KnnClassifier::from_bytes(knn::BUILTIN_MODEL, Path::new("builtin"), knn::EXPECT).unwrap();
+    let builtin = Classifier::Knn(Arc::new(builtin));
+    let confidence = |n: Option<&NormalImage>| {
+        let m = classify(&test, n, Some(&fg), None, &builtin, &opts).unwrap();
+        m.confidence.into_vec()
+    };
+    let (with, without) = (confidence(Some(&normals)), confidence(None));
+    let differ = with.iter().zip(&without).filter(|(a, b)| a != b).count();
+    assert!(differ > 100, "{differ} pixels differ");
 }
 
 /// The shipped default model loads, and its header names this program's task, feature

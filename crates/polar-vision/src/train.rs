@@ -10,11 +10,12 @@ use polar_io::GroundTruth;
 use polar_io::Validation;
 use polar_learn::{Expect, KnnModel, TrainingSummary};
 use polar_sensor::Observation;
+use polar_shape::{ShapeOptions, estimate_shape};
 use rayon::prelude::*;
 
 use crate::error::CliError;
 use crate::eval::{progress, select_samples};
-use crate::input::{InputArgs, Source, read_observation, resolve};
+use crate::input::{InputArgs, Source, camera_model, read_observation, resolve};
 
 /// The tasks that have a learned model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -44,6 +45,15 @@ impl TrainTask {
         }
     }
 
+    /// Where the features' normals and object mask come from, where another task gives
+    /// them (the model's summary says so).
+    fn cues(self) -> Option<&'static str> {
+        match self {
+            TrainTask::Material => Some("sfp normals and object mask (default options)"),
+            TrainTask::Transparent => None,
+        }
+    }
+
     /// Appends the training points of one sample (none where it lacks the labels).
     fn add_pixels(
         self,
@@ -54,8 +64,17 @@ impl TrainTask {
     ) -> Result<(), String> {
         match (self, &gt.material, &gt.transparent) {
             (TrainTask::Material, Some(labels), _) => {
-                polar_material::knn::add_training_pixels(obs, labels, points, classes)
-                    .map_err(|e| e.to_string())
+                let shape =
+                    estimate_shape(obs, &ShapeOptions::default()).map_err(|e| e.to_string())?;
+                polar_material::knn::add_training_pixels(
+                    obs,
+                    Some(&shape.normal),
+                    Some(&shape.foreground),
+                    labels,
+                    points,
+                    classes,
+                )
+                .map_err(|e| e.to_string())
             }
             (TrainTask::Transparent, _, Some(labels)) => {
                 polar_transparency::knn::add_training_pixels(obs, labels, points, classes)
@@ -71,7 +90,8 @@ impl TrainTask {
 #[command(
     after_help = "Reads every sample directory of DATASET (as `eval` does) through the same input \
 path as `run` (raw.png by default), computes the task's per-pixel features on the pixels the \
-classifier takes for objects, labels them from the sample's ground truth, keeps a class-balanced \
+classifier takes for objects (material: with the normals and object mask of shape from polarization \
+at its default options, as `run` gives them), labels them from the sample's ground truth, keeps a class-balanced \
 subsample of at most --max-points (fixed by --seed: the same command gives the same file), and \
 writes the model file: format version, task, feature list, standardization, k, the training set's \
 summary and the points. Use it with `run --material-model FILE` or `run --transparent-method \
@@ -154,7 +174,9 @@ pub fn train(args: &TrainArgs) -> Result<bool, CliError> {
 /// Feature vectors and classes of one sample's labelled pixels.
 fn sample_pixels(sample: &Path, args: &TrainArgs) -> Result<(Vec<f32>, Vec<u8>), CliError> {
     let file = resolve(sample, args.input)?;
-    let (obs, _) = read_observation(&file, &args.read)?;
+    let (mut obs, _) = read_observation(&file, &args.read)?;
+    let meta = polar_io::read_optional_meta(sample)?;
+    obs.camera = camera_model(None, meta.as_ref());
     let gt = polar_io::read_ground_truth(sample, Validation::Check)?;
     let (mut points, mut classes) = (Vec::new(), Vec::new());
     args.task
@@ -176,6 +198,7 @@ fn summary(args: &TrainArgs, samples: usize) -> TrainingSummary {
         ("seed", args.seed.to_string()),
     ]
     .into_iter()
+    .chain(args.task.cues().map(|c| ("cues", c.to_owned())))
     .map(|(k, v)| (k.to_owned(), v))
     .collect();
     TrainingSummary {
