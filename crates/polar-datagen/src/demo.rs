@@ -27,6 +27,7 @@ pub fn realistic_noise() -> NoiseLevel {
         bits: u8::try_from(p.bit_depth).expect("the preset's bit depth is at most 16"),
         shot_noise: p.shot_noise,
         extinction_ratio: Some(p.extinction_ratio),
+        exposure: None,
     }
 }
 
@@ -187,6 +188,7 @@ pub fn noise_from_settings(s: &SensorSettings) -> NoiseLevel {
         bits: s.bits.unwrap_or(r.bits),
         shot_noise: s.shot_noise.unwrap_or(r.shot_noise),
         extinction_ratio: s.extinction_ratio.or(r.extinction_ratio),
+        exposure: None,
     }
 }
 

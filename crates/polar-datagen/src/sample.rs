@@ -15,7 +15,8 @@ use crate::run::{SampleWorker, WorkReport};
 use crate::scene::build_scene;
 use crate::suite::NoiseLevel;
 
-/// Fraction of the full well that the 99th percentile of S0 reaches (auto-exposure headroom).
+/// Fraction of the full well that the 99th percentile of S0 reaches (auto-exposure headroom)
+/// unless the noise level sets its own [`NoiseLevel::exposure`].
 const EXPOSURE_TARGET: f64 = 0.8;
 /// Percentile of S0 used for auto-exposure: ignores a few specular highlights.
 const EXPOSURE_QUANTILE: f64 = 0.99;
@@ -65,7 +66,7 @@ pub fn sensor_model(noise: &NoiseLevel, stokes: &StokesImage, seed: u64) -> Sens
     let level = polar_image::quantile(s0.as_slice().iter().copied(), EXPOSURE_QUANTILE)
         .map_or(0.0, f64::from);
     let electrons_per_unit = if level > 0.0 {
-        EXPOSURE_TARGET * noise.full_well_e / level
+        noise.exposure.unwrap_or(EXPOSURE_TARGET) * noise.full_well_e / level
     } else {
         1.0
     };
@@ -272,4 +273,27 @@ pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
             .map_err(io_err(polar_io::files::vision::PICTURES))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The exposure of a noise level scales the photons per unit of S0 from the default
+    /// auto-exposure (the 99th percentile of S0 at 80 % of the full well) by `exposure / 0.8`.
+    #[test]
+    fn exposure_scales_the_auto_exposure() {
+        let mut stokes = StokesImage::new(10, 10);
+        for (k, p) in stokes.pixels_mut().iter_mut().enumerate() {
+            p[0] = 1.0 + k as f32;
+        }
+        let noise = crate::demo::realistic_noise();
+        let default = sensor_model(&noise, &stokes, 1).photons_per_unit;
+        let over = NoiseLevel {
+            exposure: Some(2.4),
+            ..noise
+        };
+        let ratio = sensor_model(&over, &stokes, 1).photons_per_unit / default;
+        assert!((ratio - 3.0).abs() < 1e-12, "{ratio}");
+    }
 }

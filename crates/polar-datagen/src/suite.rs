@@ -58,6 +58,10 @@ pub struct NoiseLevel {
     /// Micro-polarizer extinction ratio T_max / T_min; absent = ideal polarizers.
     #[serde(default)]
     pub extinction_ratio: Option<f64>,
+    /// Fraction of the full well the 99th percentile of S0 reaches (auto-exposure); absent =
+    /// 0.8. Above 1 over-exposes (the brightest objects saturate), small values under-expose.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exposure: Option<f64>,
 }
 
 /// What a family of samples is for; decides its parameters and scene layout.
@@ -670,9 +674,22 @@ impl Suite {
     }
 }
 
+/// Bounds of [`NoiseLevel::exposure`]: from a frame a few electrons deep to one saturated
+/// almost everywhere.
+const MIN_EXPOSURE: f64 = 1e-3;
+/// See [`MIN_EXPOSURE`].
+const MAX_EXPOSURE: f64 = 20.0;
+
 /// Checks a noise level with the bounds of the sensor settings (`polar_sensor`); the
 /// message starts with the key.
 fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
+    if let Some(e) = n.exposure
+        && !(MIN_EXPOSURE..=MAX_EXPOSURE).contains(&e)
+    {
+        return Err(format!(
+            "exposure = {e} must be in {MIN_EXPOSURE}..={MAX_EXPOSURE} (fraction of the full well at the 99th percentile of S0)"
+        ));
+    }
     SensorSettings {
         full_well_e: Some(n.full_well_e),
         read_noise_e: Some(n.read_noise_e),
@@ -821,6 +838,30 @@ ranges = { ior = [1.4, 1.6] }
             e.contains("family 'sfp'") && e.contains("noise = []"),
             "{e}"
         );
+    }
+
+    /// A noise level's exposure is read, absent by default, and refused outside its bounds
+    /// (0, NaN, a hundredfold over-exposure) naming the key.
+    #[test]
+    fn exposure_is_read_and_bounded() {
+        assert_eq!(Suite::parse(MINI).unwrap().noise[0].exposure, None);
+        let with = |v: &str| {
+            MINI.replace(
+                "shot_noise = false",
+                &format!("shot_noise = false\nexposure = {v}"),
+            )
+        };
+        assert_eq!(
+            Suite::parse(&with("2.5")).unwrap().noise[0].exposure,
+            Some(2.5)
+        );
+        for bad in ["0", "nan", "100"] {
+            let e = err_of(&with(bad));
+            assert!(
+                e.contains("exposure") && e.contains("must be in"),
+                "{bad}: {e}"
+            );
+        }
     }
 
     #[test]
