@@ -79,8 +79,9 @@ impl Cues {
     /// other way (a face turned to the camera is read as turned away), which only makes
     /// the Fresnel cue more cautious; it also lets the phase cue count the pixels it
     /// puts near the occluding contour.
-    pub fn with_prior_floor(mut self, f: &Features, fg: &[bool], regions: &Regions) -> Self {
-        let prior = sphere_prior_zenith(fg, regions, f.width, f.height);
+    /// `distance`: [`chamfer_distance`] of the object mask the `regions` label.
+    pub fn with_prior_floor(mut self, regions: &Regions, distance: &[f32]) -> Self {
+        let prior = sphere_prior_zenith(regions, distance);
         for (z, &p) in self.zenith.iter_mut().zip(&prior) {
             if p.is_finite() && (z.is_nan() || *z < p) {
                 *z = p;
@@ -96,11 +97,13 @@ pub const BAND: usize = 3;
 /// Cues from the silhouette of the object mask `fg`: phase in a band of [`BAND`] pixels
 /// inside the boundary; zenith from a sphere prior: a pixel at distance `d` from the
 /// silhouette of a region whose largest such distance is `R` sees `sin θ = 1 − d/R`
-/// (exact for a sphere, a rough guess for other convex shapes).
+/// (exact for a sphere, a rough guess for other convex shapes). `distance`:
+/// [`chamfer_distance`] of `fg`.
 pub fn from_silhouette(
     f: &Features,
     fg: &[bool],
     regions: &Regions,
+    distance: &[f32],
 ) -> Result<Cues, MaterialError> {
     let (w, h) = (f.width, f.height);
     let m =
@@ -129,7 +132,7 @@ pub fn from_silhouette(
             (2.0 * (f.aolp(k) - beta)).sin_cos()
         })
         .unzip();
-    let zenith = sphere_prior_zenith(fg, regions, w, h);
+    let zenith = sphere_prior_zenith(regions, distance);
     Ok(Cues {
         phase,
         phase_sin,
@@ -138,18 +141,17 @@ pub fn from_silhouette(
     })
 }
 
-/// Zenith of the sphere prior (NaN outside `fg`), from the chamfer distance to the
-/// nearest pixel outside `fg` (or outside the image) and its maximum per region.
-fn sphere_prior_zenith(fg: &[bool], regions: &Regions, w: usize, h: usize) -> Vec<f32> {
-    let d = chamfer_distance(fg, w, h);
+/// Zenith of the sphere prior (NaN outside the mask), from each pixel's chamfer distance
+/// to the nearest pixel outside the mask (or the image) and its maximum per region.
+fn sphere_prior_zenith(regions: &Regions, d: &[f32]) -> Vec<f32> {
     let lab = &regions.labels;
     let mut rmax = vec![0.0f32; regions.count + 1];
     for (k, &l) in lab.iter().enumerate() {
         rmax[l as usize] = rmax[l as usize].max(d[k]);
     }
-    par_map(w * h, |k| {
+    par_map(d.len(), |k| {
         let r = rmax[lab[k] as usize];
-        if !fg[k] || r <= 0.0 {
+        if d[k] <= 0.0 || r <= 0.0 {
             return f32::NAN;
         }
         // The outermost pixel centre lies half a pixel inside the silhouette.

@@ -64,6 +64,9 @@ pub struct Prepared {
     pub fg: Vec<bool>,
     /// The 8-connected regions of `fg`.
     pub regions: Regions,
+    /// Chamfer distance of each pixel to the nearest pixel outside `fg` (0 outside it):
+    /// the sphere prior's and the neck splitting's one distance map.
+    pub distance: Vec<f32>,
     /// Phase and zenith cues, from the normals where given, else from the silhouettes.
     pub cues: cues::Cues,
 }
@@ -187,16 +190,16 @@ pub fn prepare(
         None => foreground::estimate(&features)?,
     };
     let regions = Regions::new(&fg, size.0, size.1)?;
+    let distance = cues::chamfer_distance(&fg, size.0, size.1);
     let cues = match normals {
-        Some(n) => {
-            cues::from_normals(obs, &features, n)?.with_prior_floor(&features, &fg, &regions)
-        }
-        None => cues::from_silhouette(&features, &fg, &regions)?,
+        Some(n) => cues::from_normals(obs, &features, n)?.with_prior_floor(&regions, &distance),
+        None => cues::from_silhouette(&features, &fg, &regions, &distance)?,
     };
     Ok(Prepared {
         features,
         fg,
         regions,
+        distance,
         cues,
     })
 }

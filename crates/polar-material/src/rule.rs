@@ -221,11 +221,11 @@ pub fn metal_probability(p: &Prepared, smooth: bool) -> Result<Vec<f32>, Materia
 fn merged_metal(p: &Prepared, region_metal: &[f32]) -> Result<Vec<f32>, MaterialError> {
     let (w, h) = (p.features.width, p.features.height);
     let region = &p.regions.labels;
-    // Only the regions voted dielectric; whole regions, so the distances are unchanged.
+    // Only the regions voted dielectric. Whole 8-connected regions, so the distance to
+    // the outside of these is the distance to the outside of the mask.
     let voted_dielectric = |k: usize| region_metal[region[k] as usize] < 0.5;
     let m: Vec<bool> = (0..w * h).map(|k| p.fg[k] && voted_dielectric(k)).collect();
-    let dist = crate::cues::chamfer_distance(&m, w, h);
-    let (labels, count) = split_at_necks(&m, &dist, w, h, NECK_RATIO, MIN_BLOB_RADIUS)?;
+    let (labels, count) = split_at_necks(&m, &p.distance, w, h, NECK_RATIO, MIN_BLOB_RADIUS)?;
     let blobs = Regions { labels, count };
     let metal: Vec<f32> = tallies(&p.features, &p.cues, &blobs)
         .iter()
