@@ -33,7 +33,10 @@
 //!    the AoLP is random (a depolarizing floor, its shadows and texture; only noise and
 //!    demosaicing residue), up to `Σg²⁻¹·(Σg)²` where it is one smooth field (an object).
 //!    Regions are `z` above Otsu's threshold of `z`, opened by 3×3, without components
-//!    smaller than the window (`π (2σ)²` pixels);
+//!    smaller than the window (`π (2σ)²` pixels) and without those polarized no more
+//!    than the background ([`polarized_above_background`]): a floor's AoLP can be
+//!    coherent where its DoLP is only noise and demosaicing residue, and where the
+//!    objects are few and small Otsu's threshold falls inside that floor's coherence;
 //! 2. holes are filled unless an occluding contour bounds them: the diffuse DoLP peaks
 //!    at grazing, so around a hole seen through an object (a torus) the DoLP is highest
 //!    next to the hole, while around a patch facing the camera (low DoLP) it rises away
@@ -72,7 +75,7 @@
 use std::collections::VecDeque;
 use std::ops::RangeInclusive;
 
-use polar_image::Gray;
+use polar_image::{Gray, quantile};
 use polar_imgproc::mask::{components, fill_holes, remove_small};
 use polar_imgproc::{
     Border, MorphShape, dilate, erode, gaussian_blur, gaussian_kernel, open, sep_filter, sobel,
@@ -139,6 +142,14 @@ const FACE_DOLP_FACTOR: f32 = 2.0;
 /// background, light reflected onto the floor by the objects counted as polarized and
 /// made faces of the floor in a torus's hole.
 const MIN_BACKGROUND_DOLP: f32 = 0.01;
+/// DoLP ([`DOLP_QUANTILE`]), in units of the background's, above which a coherent region
+/// (cue B) is an object's: the floor's AoLP can be coherent where its DoLP is no more
+/// than the background's noise and demosaicing residue (a brightness gradient polarizes
+/// a division-of-focal-plane mosaic along one angle). On the dev, full-size, Mitsuba and
+/// hard-case sets the floor's coherent regions sit near 1, objects' mostly far above.
+const COHERENT_DOLP_FACTOR: f32 = 1.2;
+/// The quantile of the DoLP that [`COHERENT_DOLP_FACTOR`] compares.
+const DOLP_QUANTILE: f64 = 0.75;
 /// Passes of [`trim_boundary`] (each peels at most one pixel).
 const TRIM_PASSES: usize = 2;
 /// Half-width (pixels) of the window [`trim_boundary`] compares a boundary pixel in.
@@ -612,6 +623,7 @@ fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
     let opened = morph_mask(&raw, w, h, Morph::Open)?;
     let window = std::f64::consts::PI * (2.0 * COHERENCE_SIGMA).powi(2);
     let regions = remove_small(&opened, w, h, window as usize)?;
+    let regions = polarized_above_background(cues, regions)?;
     let filled = fill_object_holes(cues, &regions)?;
     let regions = inner_or_with_contour(cues, &filled)?;
     let all_holes = fill_holes(&regions, w, h)?;
@@ -620,6 +632,30 @@ fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
         regions,
         open_holes,
     })
+}
+
+/// The components of cue B's `regions` polarized above the background: their
+/// [`DOLP_QUANTILE`] of the DoLP above [`COHERENT_DOLP_FACTOR`] times that of the valid
+/// pixels outside them (at least [`MIN_BACKGROUND_DOLP`]). A quantile above the median,
+/// as an object is polarized mostly toward its rim.
+fn polarized_above_background(cues: &Cues, regions: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let (id, n) = components(&regions, w, h)?;
+    let outside = (0..w * h).filter(|&k| cues.valid[k] && id[k] == 0);
+    let Some(background) = quantile(outside.map(|k| cues.dolp[k]), DOLP_QUANTILE) else {
+        return Ok(regions);
+    };
+    let bar = COHERENT_DOLP_FACTOR * background.max(MIN_BACKGROUND_DOLP);
+    let mut dolp: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
+    for k in (0..w * h).filter(|&k| id[k] > 0 && cues.valid[k]) {
+        dolp[id[k] as usize].push(cues.dolp[k]);
+    }
+    let keep: Vec<bool> = dolp
+        .into_iter()
+        .enumerate()
+        .map(|(c, d)| c > 0 && quantile(d, DOLP_QUANTILE).is_some_and(|q| q > bar))
+        .collect();
+    Ok(id.iter().map(|&i| keep[i as usize]).collect())
 }
 
 /// Rayleigh statistic `z = |Σ g e^{2iα}|² / Σ g²` of the AoLP over a Gaussian window `g`

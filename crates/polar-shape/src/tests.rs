@@ -1208,3 +1208,30 @@ fn boundary_trim_gives_the_floor_ring_back() {
         );
     }
 }
+
+/// A patch of floor whose AoLP is one angle but whose DoLP (0.012) is no more than the
+/// floor's noise (up to 0.02) is no coherent region: cue B keeps the sphere (IoU as in
+/// `textured_floor_and_cast_shadow_are_not_coherent_foreground`) and none of the patch,
+/// which without the DoLP test is as coherent as the sphere.
+#[test]
+fn coherent_floor_patch_at_the_noise_level_is_not_coherent_foreground() {
+    let (mut scene, truth) = left_sphere();
+    add_polarization_noise(&mut scene, 0.02);
+    let patch = |k: usize| {
+        let (dx, dy) = ((k % 96) as f64 - 78.0, (k / 96) as f64 - 20.0);
+        dx * dx + dy * dy < 12.0 * 12.0
+    };
+    let a = 2.0 * 30f32.to_radians();
+    for (k, st) in scene.stokes.iter_mut().enumerate() {
+        if patch(k) {
+            st[1] = 0.012 * a.cos() * st[0];
+            st[2] = 0.012 * a.sin() * st[0];
+        }
+    }
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let taken = (0..fg.len()).filter(|&k| fg[k] && patch(k)).count();
+    assert_eq!(taken, 0, "the coherent floor patch taken as foreground");
+    let iou = mask_iou(&fg, &truth);
+    assert!(iou > 0.8, "sphere IoU {iou}");
+}
