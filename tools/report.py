@@ -44,7 +44,7 @@ TASKS = {
     "material": (["materials", "mts-material"], "metal_vs_dielectric_accuracy", "metal vs dielectric accuracy",
                  False, {"physics rule, with sfp normals": ["--tasks", "sfp,material"],
                          "physics rule, no normals": ["--tasks", "material"],
-                         "kNN, builtin model": ["--tasks", "material", "--material-model", "builtin"]}),
+                         "kNN, builtin model, with sfp normals": ["--tasks", "sfp,material", "--material-model", "builtin"]}),
     "transparent": (["glass"], "iou", "mask IoU", False, {
         "training-free": [],
         "kNN, builtin model": ["--transparent-method", "learned"],
