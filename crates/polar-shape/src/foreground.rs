@@ -34,9 +34,10 @@
 //!    demosaicing residue), up to `Σg²⁻¹·(Σg)²` where it is one smooth field (an object).
 //!    Regions are `z` above Otsu's threshold of `z`, opened by 3×3, without components
 //!    smaller than the window (`π (2σ)²` pixels) and without those polarized no more
-//!    than the background ([`polarized_above_background`]): a floor's AoLP can be
-//!    coherent where its DoLP is only noise and demosaicing residue, and where the
-//!    objects are few and small Otsu's threshold falls inside that floor's coherence;
+//!    than the background and without an occluding-contour signature ([`object_like`]):
+//!    a floor's AoLP can be coherent where its DoLP is only noise and demosaicing
+//!    residue, and where the objects are few and small Otsu's threshold falls inside
+//!    that floor's coherence;
 //! 2. holes are filled unless an occluding contour bounds them: the diffuse DoLP peaks
 //!    at grazing, so around a hole seen through an object (a torus) the DoLP is highest
 //!    next to the hole, while around a patch facing the camera (low DoLP) it rises away
@@ -143,7 +144,7 @@ const FACE_DOLP_FACTOR: f32 = 2.0;
 /// made faces of the floor in a torus's hole.
 const MIN_BACKGROUND_DOLP: f32 = 0.01;
 /// DoLP ([`DOLP_QUANTILE`]), in units of the background's, above which a coherent region
-/// (cue B) is an object's: the floor's AoLP can be coherent where its DoLP is no more
+/// (cue B) is an object's without a contour signature: the floor's AoLP can be coherent where its DoLP is no more
 /// than the background's noise and demosaicing residue (a brightness gradient polarizes
 /// a division-of-focal-plane mosaic along one angle). On the dev, full-size, Mitsuba and
 /// hard-case sets the floor's coherent regions sit near 1, objects' mostly far above.
@@ -623,7 +624,7 @@ fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
     let opened = morph_mask(&raw, w, h, Morph::Open)?;
     let window = std::f64::consts::PI * (2.0 * COHERENCE_SIGMA).powi(2);
     let regions = remove_small(&opened, w, h, window as usize)?;
-    let regions = polarized_above_background(cues, regions)?;
+    let regions = object_like(cues, regions)?;
     let filled = fill_object_holes(cues, &regions)?;
     let regions = inner_or_with_contour(cues, &filled)?;
     let all_holes = fill_holes(&regions, w, h)?;
@@ -634,11 +635,13 @@ fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
     })
 }
 
-/// The components of cue B's `regions` polarized above the background: their
-/// [`DOLP_QUANTILE`] of the DoLP above [`COHERENT_DOLP_FACTOR`] times that of the valid
-/// pixels outside them (at least [`MIN_BACKGROUND_DOLP`]). A quantile above the median,
-/// as an object is polarized mostly toward its rim.
-fn polarized_above_background(cues: &Cues, regions: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
+/// The components of cue B's `regions` that are an object's: polarized above the
+/// background (their [`DOLP_QUANTILE`] of the DoLP above [`COHERENT_DOLP_FACTOR`] times that
+/// of the valid pixels outside them, at least [`MIN_BACKGROUND_DOLP`]; a quantile above
+/// the median, as an object is polarized mostly toward its rim), or with the
+/// occluding-contour signature along their boundary ([`has_contour`]: a smooth metal is
+/// polarized no more than the floor, but across its silhouette's normal).
+fn object_like(cues: &Cues, regions: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let (id, n) = components(&regions, w, h)?;
     let outside = (0..w * h).filter(|&k| cues.valid[k] && id[k] == 0);
@@ -650,10 +653,16 @@ fn polarized_above_background(cues: &Cues, regions: Vec<bool>) -> Result<Vec<boo
     for k in (0..w * h).filter(|&k| id[k] > 0 && cues.valid[k]) {
         dolp[id[k] as usize].push(cues.dolp[k]);
     }
+    let contour = contour_sums(cues, &regions, &id, n)?;
     let keep: Vec<bool> = dolp
         .into_iter()
         .enumerate()
-        .map(|(c, d)| c > 0 && quantile(d, DOLP_QUANTILE).is_some_and(|q| q > bar))
+        .map(|(c, d)| {
+            let [cos, weight, weight_sq] = contour[c];
+            c > 0
+                && (quantile(d, DOLP_QUANTILE).is_some_and(|q| q > bar)
+                    || has_contour(cos, weight, weight_sq))
+        })
         .collect();
     Ok(id.iter().map(|&i| keep[i as usize]).collect())
 }
