@@ -144,10 +144,11 @@ const FACE_DOLP_FACTOR: f32 = 2.0;
 /// made faces of the floor in a torus's hole.
 const MIN_BACKGROUND_DOLP: f32 = 0.01;
 /// DoLP ([`DOLP_QUANTILE`]), in units of the background's, above which a coherent region
-/// (cue B) is an object's without a contour signature: the floor's AoLP can be coherent where its DoLP is no more
-/// than the background's noise and demosaicing residue (a brightness gradient polarizes
-/// a division-of-focal-plane mosaic along one angle). On the dev, full-size, Mitsuba and
-/// hard-case sets the floor's coherent regions sit near 1, objects' mostly far above.
+/// (cue B) without a contour signature is an object's: the floor's AoLP can be coherent
+/// where its DoLP is no more than the background's noise and demosaicing residue (a
+/// brightness gradient polarizes a division-of-focal-plane mosaic along one angle). On the
+/// dev, full-size, Mitsuba and hard-case sets the floor's coherent regions sit near 1,
+/// objects' mostly far above.
 const COHERENT_DOLP_FACTOR: f32 = 1.2;
 /// The quantile of the DoLP that [`COHERENT_DOLP_FACTOR`] compares.
 const DOLP_QUANTILE: f64 = 0.75;
