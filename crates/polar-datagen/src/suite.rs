@@ -687,7 +687,8 @@ fn validate_noise(n: &NoiseLevel) -> Result<(), String> {
         && !(MIN_EXPOSURE..=MAX_EXPOSURE).contains(&e)
     {
         return Err(format!(
-            "exposure = {e} must be in {MIN_EXPOSURE}..={MAX_EXPOSURE} (fraction of the full well at the 99th percentile of S0)"
+            "exposure = {e} must be in {MIN_EXPOSURE}..={MAX_EXPOSURE} \
+             (fraction of the full well at the 99th percentile of S0)"
         ));
     }
     SensorSettings {
