@@ -865,6 +865,25 @@ ranges = { ior = [1.4, 1.6] }
         }
     }
 
+    /// Every suite file shipped in `datasets-synth/suites` is valid (a suite with a typo
+    /// would otherwise fail only when someone renders it).
+    #[test]
+    fn every_shipped_suite_parses() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets-synth/suites");
+        let mut names = Vec::new();
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                let suite =
+                    Suite::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                assert!(!suite.families.is_empty(), "{}", path.display());
+                names.push(suite.name);
+            }
+        }
+        assert!(names.iter().any(|n| n == "material-hard"), "{names:?}");
+        assert!(names.len() >= 10, "{names:?}");
+    }
+
     #[test]
     fn unknown_field_and_bad_version_are_rejected() {
         assert!(err_of(&MINI.replace("seed = 7", "seed = 7\ncolour = 3")).contains("colour"));
