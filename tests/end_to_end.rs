@@ -103,6 +103,7 @@ fn train_material_then_eval_with_the_model() {
         "metal_vs_dielectric_accuracy",
     );
     assert!((0.0..=1.0).contains(&acc), "{acc}");
+    per_class_iou_is_summarised(&out);
     // A resumed eval reuses a record only if the model's contents are the same: the same
     // file reruns nothing, the file retrained in place (other points) reruns the samples.
     let record = out
@@ -209,6 +210,19 @@ fn shape_from_polarization_on_the_ci_shape_family() {
     // (0.90 on the dev set); 0.7 leaves room for a few boundary pixels either way.
     assert!(coverage > 0.7, "coverage {coverage}");
     worst_sfp_samples_are_shown(dir.path(), &m);
+}
+
+/// summary.md gives the material task's IoU per class (dielectric, metal): the family means
+/// of `class_iou` in metrics.json, each in [0, 1].
+fn per_class_iou_is_summarised(out: &std::path::Path) {
+    let m = json(&out.join(vision::METRICS));
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    for (label, class) in [("dielectric IoU", 1), ("metal IoU", 2)] {
+        let iou = family_mean(&m, "materials", "material", &format!("class_iou.{class}"));
+        assert!((0.0..=1.0).contains(&iou), "{label} {iou}");
+        let row = format!("| {label} | {iou:.4} |");
+        assert!(summary.contains(&row), "{row} not in\n{summary}");
+    }
 }
 
 /// summary.md lists the sfp samples with the largest mean error, largest first, each with

@@ -300,7 +300,7 @@ fn write_report(
 }
 
 /// The headline figures of each task, in the order a reader looks for them.
-const HEADLINES: [(&str, &str, &str); 14] = [
+const HEADLINES: [(&str, &str, &str); 16] = [
     ("sfp", "normal.mean_deg", "mean angular error (deg)"),
     (
         "sfp",
@@ -319,6 +319,8 @@ const HEADLINES: [(&str, &str, &str); 14] = [
         "opaque_coverage",
         "share of opaque object pixels labelled metal or dielectric",
     ),
+    ("material", "class_iou.1", "dielectric IoU"),
+    ("material", "class_iou.2", "metal IoU"),
     ("transparent", "iou", "mask IoU"),
     (
         "transparent",
