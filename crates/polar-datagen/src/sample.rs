@@ -279,8 +279,8 @@ pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
 mod tests {
     use super::*;
 
-    /// The exposure of a noise level scales the photons per unit of S0 from the default
-    /// auto-exposure (the 99th percentile of S0 at 80 % of the full well) by `exposure / 0.8`.
+    /// A noise level's exposure replaces [`EXPOSURE_TARGET`]: the photons per unit of S0
+    /// scale by `exposure / EXPOSURE_TARGET`.
     #[test]
     fn exposure_scales_the_auto_exposure() {
         let mut stokes = StokesImage::new(10, 10);
@@ -294,6 +294,10 @@ mod tests {
             ..noise
         };
         let ratio = sensor_model(&over, &stokes, 1).photons_per_unit / default;
-        assert!((ratio - 3.0).abs() < 1e-12, "{ratio}");
+        let expected = 2.4 / EXPOSURE_TARGET;
+        assert!(
+            (ratio - expected).abs() < 1e-12,
+            "{ratio} against {expected}"
+        );
     }
 }

@@ -641,6 +641,12 @@ fn add_polarization_noise(scene: &mut Scene, noise: f64) {
     }
 }
 
+/// Cue B's regions (the coherently polarized ones) of `scene`, index 1.5.
+fn coherent_foreground(scene: &Scene) -> Vec<bool> {
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    crate::foreground::coherent_regions(&cues).unwrap()
+}
+
 /// Foreground IoU of `fg` against `truth` (`true` = object).
 fn mask_iou(fg: &[bool], truth: &[bool]) -> f64 {
     let inter = fg.iter().zip(truth).filter(|(a, b)| **a && **b).count();
@@ -675,8 +681,7 @@ fn sphere_on_textured_floor() -> (Scene, Vec<bool>) {
 #[test]
 fn textured_floor_and_cast_shadow_are_not_coherent_foreground() {
     let (scene, shadow) = sphere_on_textured_floor();
-    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
-    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let fg = coherent_foreground(&scene);
     let truth: Vec<bool> = scene
         .normals
         .iter()
@@ -866,8 +871,7 @@ fn torus_scene(big_r: f64, r: f64, background: f64, noise: f64) -> Scene {
 #[test]
 fn torus_hole_stays_background() {
     let scene = torus_scene(0.14, 0.07, 0.3, 0.02);
-    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
-    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let fg = coherent_foreground(&scene);
     let truth: Vec<bool> = scene
         .normals
         .iter()
@@ -979,8 +983,7 @@ fn sphere_centre_facing_camera_is_filled() {
     // an incoherent hole whose DoLP rises away from it, so it is filled.
     let mut scene = sphere_scene(96, 1.5);
     add_polarization_noise(&mut scene, 0.02);
-    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
-    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let fg = coherent_foreground(&scene);
     let truth: Vec<bool> = scene
         .normals
         .iter()
@@ -1228,8 +1231,7 @@ fn coherent_floor_patch_at_the_noise_level_is_not_coherent_foreground() {
             st[2] = 0.012 * a.sin() * st[0];
         }
     }
-    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
-    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let fg = coherent_foreground(&scene);
     let taken = (0..fg.len()).filter(|&k| fg[k] && patch(k)).count();
     assert_eq!(taken, 0, "the coherent floor patch taken as foreground");
     let iou = mask_iou(&fg, &truth);
@@ -1254,8 +1256,7 @@ fn weakly_polarized_metal_like_sphere_stays_coherent_foreground() {
             st[2] *= f;
         }
     }
-    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
-    let fg = crate::foreground::coherent_regions(&cues).unwrap();
+    let fg = coherent_foreground(&scene);
     let iou = mask_iou(&fg, &truth);
     assert!(iou > 0.7, "sphere IoU {iou}");
 }
