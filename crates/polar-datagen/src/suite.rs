@@ -403,13 +403,13 @@ const TRANSPARENT: &[ParamSpec] = &[
 const HAZE: &[ParamSpec] = &[
     p(
         "camera_distance",
-        [3.0, 6.0],
+        [3.0, 40.0],
         [0.5, 100.0],
         "depth of the nearest object, m",
     ),
     p(
         "camera_elevation_deg",
-        [0.0, 4.0],
+        [0.0, 8.0],
         [-10.0, 45.0],
         "downward pitch of the view, degrees",
     ),
@@ -445,7 +445,7 @@ const HAZE: &[ParamSpec] = &[
     ),
     p(
         "scene_depth",
-        [20.0, 150.0],
+        [60.0, 200.0],
         [1.0, 10000.0],
         "distance of the farthest object, m",
     ),
