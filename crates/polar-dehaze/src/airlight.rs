@@ -24,10 +24,11 @@
 //! 4. **`p` and `A_inf` over the frame** (`varying_airlight`, [`SkyField`]). Neither is
 //!    one number: `p` follows the scattering angle, and the sky is brighter towards the
 //!    sun. Blocks with `P / S0 >= SKY_LEVEL p` and `P / p >= SKY_LEVEL A_inf` are sky
-//!    candidates; an upper-envelope plane of their `P / S0` picks those at infinity,
-//!    inside extended regions; a plane fitted to them gives `p(x, y)` and the
-//!    upper-envelope plane of their airlight gives `A_inf(x, y)` (both clamped to the
-//!    range seen). Needs [`MIN_SKY_BLOCKS`] of them; otherwise 1.-3. stand.
+//!    candidates; an upper-envelope plane of their `P / S0` picks those at infinity; a
+//!    plane fitted to them gives `p(x, y)`, and the upper-envelope plane of the airlight
+//!    of those inside extended regions of candidates and near the sky's brightness gives
+//!    `A_inf(x, y)` (both clamped to the range seen). Needs [`MIN_SKY_BLOCKS`] of them;
+//!    otherwise 1.-3. stand.
 //!
 //! Failure modes (reported as warnings where they can be detected):
 //! - no sky and no black object in view: `P / S0 < p` everywhere, so `p` is underestimated
@@ -46,6 +47,8 @@
 //!   `A_inf` (a sky much brighter on one side then leaves `t > 0` on the darker side);
 //! - airlight polarization at the noise level: `p` is then noise; [`crate::polarization`]
 //!   falls back when `p < min_airlight_dolp`.
+
+use std::collections::HashSet;
 
 use polar_image::{Gray, quantile};
 use rayon::prelude::*;
@@ -433,6 +436,10 @@ pub const ENVELOPE_EXPECTILE: f64 = 0.99;
 const EXPECTILE_PASSES: usize = 10;
 /// Candidates whose `P` is within this fraction below the envelope are at infinity.
 pub const INFINITY_TOLERANCE: f64 = 0.1;
+/// Blocks at infinity whose airlight is below this share of the brightest sky's are not
+/// sky ([`bright_inner`]); a sky brighter towards the sun keeps its dimmer side down to
+/// this share.
+pub const SKY_AIRLIGHT_SHARE: f64 = 0.7;
 
 /// The airlight's degree of polarization as it varies over the frame: a plane
 /// `p(x, y) = a + b x + c y` in normalised image coordinates fitted to the blocks at
@@ -461,10 +468,10 @@ impl SkyField {
     /// [`INFINITY_TOLERANCE`] of it are taken as infinity, and the plane of `p` is refitted
     /// to them by least squares. The airlight `A = P / p(x, y)` is at most `A_inf`, with
     /// equality at infinity, so `A_inf` is the upper-envelope plane of `A` over those
-    /// blocks inside extended regions ([`interior`]) and in the top cluster of `A`
-    /// ([`upper_blocks`]): a black object also has `P / S0 = p`, at any distance, and a
-    /// ramp of them down a hazy slope would tilt the plane. `None` with fewer than 3 such
-    /// blocks (then one `p` and `A_inf` over the frame).
+    /// blocks inside extended regions of candidates and bright enough ([`bright_inner`]),
+    /// and in the top cluster of `A` ([`upper_blocks`]): a black object also has
+    /// `P / S0 = p`, at any distance, and a ramp of them down a hazy slope would tilt the
+    /// plane. `None` with fewer than 3 such blocks (then one `p` and `A_inf` over the frame).
     fn fit(blocks: &Blocks, proj: &[f32], candidates: &[usize]) -> Option<Self> {
         let eval = |c: &[f64; 3], i: usize| c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i];
         let dolp = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
@@ -489,7 +496,11 @@ impl SkyField {
             f64::from(proj[i]) / plane(&dolp_plane, dolp_range, blocks.x[i], blocks.y[i])
         };
         // Black objects pass the `p` test at any distance, but their airlight is below A_inf.
-        let top = upper_blocks(blocks, &interior(blocks, &inf), &airlight)?;
+        let top = upper_blocks(
+            blocks,
+            &bright_inner(blocks, candidates, &inf, &airlight)?,
+            &airlight,
+        )?;
         Some(Self {
             dolp: dolp_plane,
             dolp_range,
@@ -544,12 +555,42 @@ fn envelope_plane(blocks: &Blocks, idx: &[usize], v: &dyn Fn(usize) -> f64) -> O
     Some(env)
 }
 
+/// The blocks at infinity (`inf`) inside extended regions of the sky candidates
+/// ([`interior`]) whose airlight `v` is at least [`SKY_AIRLIGHT_SHARE`] of the
+/// [`AIRLIGHT_QUANTILE`] of theirs. The regions are the candidates', not those of `inf`:
+/// where noise is comparable to the spread of `P / S0` over the sky, it picks which sky
+/// blocks reach the envelope, scattered, and few of them have all four neighbours among
+/// them. Black objects and hazy ground inside the candidates' regions also reach it, at
+/// any distance; their airlight `A_inf (1 - t)` falls short of the sky's.
+fn bright_inner(
+    blocks: &Blocks,
+    candidates: &[usize],
+    inf: &[usize],
+    v: &dyn Fn(usize) -> f64,
+) -> Option<Vec<usize>> {
+    let extended: HashSet<usize> = interior(blocks, candidates).into_iter().collect();
+    let inner: Vec<usize> = inf
+        .iter()
+        .copied()
+        .filter(|i| extended.contains(i))
+        .collect();
+    let top = f64::from(quantile(
+        inner.iter().map(|&i| v(i) as f32),
+        AIRLIGHT_QUANTILE,
+    )?);
+    Some(
+        inner
+            .into_iter()
+            .filter(|&i| v(i) >= SKY_AIRLIGHT_SHARE * top)
+            .collect(),
+    )
+}
+
 /// The blocks of `idx` whose four grid neighbours are in `idx` too (or outside the frame):
 /// the inside of extended regions. A sky is one; a black object, whose `P / S0` is `p` at
 /// any distance, is usually too small to keep a block.
 fn interior(blocks: &Blocks, idx: &[usize]) -> Vec<usize> {
-    let set: std::collections::HashSet<(usize, usize)> =
-        idx.iter().map(|&i| blocks.cell[i]).collect();
+    let set: HashSet<(usize, usize)> = idx.iter().map(|&i| blocks.cell[i]).collect();
     let (gw, gh) = blocks
         .cell
         .iter()

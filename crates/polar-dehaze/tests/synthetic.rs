@@ -167,6 +167,38 @@ fn sky_brighter_on_one_side_gets_a_varying_airlight() {
 }
 
 #[test]
+fn noisy_sky_still_gets_a_varying_airlight() {
+    // The tilted sky of the test above, its S1 and S2 noisy (uniform, up to 0.1 S0 per
+    // pixel: a standard deviation of 0.019 in `P / S0` over a 3x3 block, against p = 0.3
+    // and the envelope's tolerance of 0.03). Noise then picks which sky blocks reach the
+    // envelope of `P / S0`, scattered over the sky; the sky planes must still be found
+    // and halve the t error of one A_inf, as without the noise.
+    let mut scene = Haze::standard(24, 0.3);
+    scene.a_tilt = 0.2;
+    let (s0, mut s1, mut s2) = scene.planes();
+    for (seed, plane) in [(21, &mut s1), (22, &mut s2)] {
+        for (k, n) in noise(seed, plane.len()).into_iter().enumerate() {
+            plane[k] += 0.1 * s0[k] * n;
+        }
+    }
+    let obs = observation(scene.w, scene.h, s0, s1, s2);
+    let interior = |k: usize| k / scene.w >= 40;
+    let t_error = |varying_airlight| {
+        let opts = DehazeOptions {
+            varying_airlight,
+            ..DehazeOptions::default()
+        };
+        let out = dehaze(&obs, &opts).unwrap();
+        mean_err(out.transmission.as_slice(), &scene.t, interior)
+    };
+    let (t_one, t_var) = (t_error(false), t_error(true));
+    assert!(
+        t_var < 0.6 * t_one,
+        "t error {t_var} vs {t_one} with one A_inf"
+    );
+}
+
+#[test]
 fn haze_free_unpolarized_input_is_left_unchanged_with_identity_fallback() {
     let mut scene = Haze::standard(0, 0.0);
     scene.t.iter_mut().for_each(|t| *t = 1.0);
