@@ -379,9 +379,9 @@ const TRANSPARENT: &[ParamSpec] = &[
     ),
     p(
         "glass_roughness",
-        [0.0, 0.05],
+        [0.0, 0.0],
         [0.0, 1.0],
-        "GGX roughness of the glass surface",
+        "GGX roughness of the glass surface (0: polished)",
     ),
     p(
         "thickness",
