@@ -127,6 +127,18 @@ fn polarization_with_sensor_noise_stays_close() {
     assert!(et < 0.05, "mean |t error| {et}");
 }
 
+/// `dehaze` with the default options, the airlight varying over the frame or not.
+fn dehaze_default(
+    obs: &polar_sensor::Observation,
+    varying_airlight: bool,
+) -> polar_dehaze::Dehazed {
+    let opts = DehazeOptions {
+        varying_airlight,
+        ..DehazeOptions::default()
+    };
+    dehaze(obs, &opts).unwrap()
+}
+
 #[test]
 fn sky_brighter_on_one_side_gets_a_varying_airlight() {
     // A_inf from 0.64 (left) to 0.96 (right), sky in the top 24 rows.
@@ -135,11 +147,7 @@ fn sky_brighter_on_one_side_gets_a_varying_airlight() {
     let obs = scene.observation();
     let interior = |k: usize| k / scene.w >= 40;
     let run = |varying_airlight| {
-        let opts = DehazeOptions {
-            varying_airlight,
-            ..DehazeOptions::default()
-        };
-        let out = dehaze(&obs, &opts).unwrap();
+        let out = dehaze_default(&obs, varying_airlight);
         let t = mean_err(out.transmission.as_slice(), &scene.t, interior);
         let l = mean_err(&unitless(&out, &scene), &scene.radiance, interior);
         (t, l, out)
@@ -184,11 +192,7 @@ fn noisy_sky_still_gets_a_varying_airlight() {
     let obs = observation(scene.w, scene.h, s0, s1, s2);
     let interior = |k: usize| k / scene.w >= 40;
     let t_error = |varying_airlight| {
-        let opts = DehazeOptions {
-            varying_airlight,
-            ..DehazeOptions::default()
-        };
-        let out = dehaze(&obs, &opts).unwrap();
+        let out = dehaze_default(&obs, varying_airlight);
         mean_err(out.transmission.as_slice(), &scene.t, interior)
     };
     let (t_one, t_var) = (t_error(false), t_error(true));

@@ -4,7 +4,7 @@
 //! Every feature is scale-free (S0 enters only divided by the frame's robust scale) and
 //! computed with the cues of [`crate::prepare`]: from the normals and object mask of shape
 //! from polarization where given, as `polar-vision train` gives them at training and `run`
-//! at inference, else from the silhouettes. A model answers for the cues it was trained on.
+//! at inference, else from the silhouettes; give a model the cues it was trained with.
 
 use polar_image::{Gray, NormalImage, par_map};
 use polar_imgproc::{Border, box_filter};
