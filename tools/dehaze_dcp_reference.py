@@ -11,9 +11,10 @@ Same steps and parameters as crates/polar-dehaze/src/dark_channel.rs + refine.rs
   t     = 1 - omega * cv2.erode(I / A, ones(patch, patch))
   t     = cv2.ximgproc.guidedFilter(I, t, radius, eps), clipped to [t0, 1]
   J     = max((I - A) / t + A, 0) * scale
-Defaults: patch 15, omega 0.95, t0 0.1 (He et al.), radius 15, eps 1e-3 (polar-dehaze's
-DehazeOptions::default()); the Rust side is compared with denoise_radius = 0 (its optional
-noise-weighted denoising of S0 is not part of He et al.'s method).
+Defaults: patch 15, omega 0.95, t0 0.1 (He et al.), radius 15, eps 1e-3; the Rust side is
+compared with the same radius (GuidedRadius::Pixels(15): its default radius is a share of
+the image size) and denoise_radius = 0 (its optional noise-weighted denoising of S0 is not
+part of He et al.'s method).
 
 Input: a float32 S0 plane as .npy, or as raw little-endian float32 .bin with --width and
 --height. Output: raw little-endian float32 .bin (or .npy by extension) of t and J.

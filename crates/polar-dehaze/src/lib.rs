@@ -110,6 +110,53 @@ pub enum WeakPolarization {
     Identity,
 }
 
+/// Radius of the guided filter that refines `t`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GuidedRadius {
+    /// This many pixels (window `2 r + 1`); 0 disables the filter.
+    Pixels(usize),
+    /// [`GuidedRadius::SHARE`] of the longer image side, the same part of the scene at any
+    /// resolution (a window wider than the objects blends a distant object's transmission
+    /// with its nearer surroundings wherever the haze leaves S0, the guide, too flat to
+    /// separate them); widened where the raw transmission is noisy until the window's mean
+    /// holds that noise to [`GuidedRadius::NOISE_TARGET`] (`sigma_t / (2 r + 1)` over its
+    /// `(2 r + 1)^2` pixels), up to [`GuidedRadius::MAX_SHARE`] of the longer side.
+    Adaptive,
+}
+
+impl GuidedRadius {
+    /// Radius of [`GuidedRadius::Adaptive`] as a share of the longer side (4 pixels at 128,
+    /// 16 at 512).
+    pub const SHARE: f64 = 1.0 / 32.0;
+    /// Largest radius of [`GuidedRadius::Adaptive`] as a share of the longer side.
+    pub const MAX_SHARE: f64 = 1.0 / 8.0;
+    /// Noise of the refined transmission that [`GuidedRadius::Adaptive`] widens its window
+    /// for.
+    pub const NOISE_TARGET: f32 = 0.002;
+
+    /// The radius before any widening for noise: [`GuidedRadius::SHARE`] of the longer
+    /// side (at least 1) for [`GuidedRadius::Adaptive`].
+    pub fn base(self, w: usize, h: usize) -> usize {
+        match self {
+            GuidedRadius::Pixels(r) => r,
+            GuidedRadius::Adaptive => ((w.max(h) as f64 * Self::SHARE).round() as usize).max(1),
+        }
+    }
+
+    /// The radius for a `w x h` image whose raw transmission has the pixel noise `t_noise`
+    /// (standard deviation; ignored by [`GuidedRadius::Pixels`]).
+    pub fn pixels(self, w: usize, h: usize, t_noise: f32) -> usize {
+        let base = self.base(w, h);
+        let noisy = t_noise.partial_cmp(&Self::NOISE_TARGET) == Some(std::cmp::Ordering::Greater);
+        if self != GuidedRadius::Adaptive || !noisy {
+            return base;
+        }
+        let for_noise = ((t_noise / Self::NOISE_TARGET - 1.0) / 2.0).ceil() as usize;
+        let most = (w.max(h) as f64 * Self::MAX_SHARE) as usize;
+        base.max(for_noise.min(most))
+    }
+}
+
 /// Options of [`dehaze`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DehazeOptions {
@@ -118,8 +165,8 @@ pub struct DehazeOptions {
     /// Lower bound of the transmission (He et al.'s `t0`): bounds the amplification
     /// `1 / t` of noise in the radiance. In `(0, 1]`.
     pub t_min: f32,
-    /// Radius of the guided filter that refines `t` (window `2 r + 1`); 0 disables it.
-    pub guided_radius: usize,
+    /// Radius of the guided filter that refines `t`.
+    pub guided_radius: GuidedRadius,
     /// Guided-filter regularisation in squared units of the normalised S0 (`S0 / s0_scale`):
     /// larger smooths `t` more across weak edges of S0.
     pub guided_eps: f32,
@@ -143,14 +190,15 @@ pub struct DehazeOptions {
 }
 
 impl Default for DehazeOptions {
-    /// Polarization, `t_min = 0.1`, guided filter `r = 15`, `eps = 1e-3`, dark channel
-    /// patch 15 and `omega = 0.95` (He et al.), `min_airlight_dolp = 0.02`, dark-channel
-    /// fallback, varying airlight, denoising radius 2.
+    /// Polarization, `t_min = 0.1`, guided filter of [`GuidedRadius::Adaptive`] radius and
+    /// `eps = 1e-3`, dark channel patch 15 and `omega = 0.95` (He et al.),
+    /// `min_airlight_dolp = 0.02`, dark-channel fallback, varying airlight, denoising
+    /// radius 2.
     fn default() -> Self {
         Self {
             method: Method::Polarization,
             t_min: 0.1,
-            guided_radius: 15,
+            guided_radius: GuidedRadius::Adaptive,
             guided_eps: 1e-3,
             dcp_patch: 15,
             dcp_omega: 0.95,
@@ -339,7 +387,27 @@ fn finish(
 
 #[cfg(test)]
 mod tests {
-    use super::Inversion;
+    use super::{GuidedRadius, Inversion};
+
+    #[test]
+    fn adaptive_guided_radius_is_a_share_of_the_frame_widened_for_noise() {
+        let r = |w, h, noise| GuidedRadius::Adaptive.pixels(w, h, noise);
+        assert_eq!(
+            (r(128, 128, 0.0), r(512, 384, 0.0), r(384, 512, 0.0)),
+            (4, 16, 16)
+        );
+        // Never 0 (which would switch the filter off), even for a 1x1 image.
+        assert_eq!((r(1, 1, 0.0), r(20, 3, 0.0)), (1, 1));
+        // t noise 0.02 needs a window of 10 pixels (r = 5) to reach 0.002; 0.05 needs 25
+        // (r = 12), more than 1/8 of 64; NaN noise leaves the share.
+        assert_eq!(
+            (r(128, 128, 0.02), r(128, 128, 0.05), r(64, 64, 0.05)),
+            (5, 12, 8)
+        );
+        assert_eq!(r(128, 128, f32::NAN), 4);
+        assert_eq!(GuidedRadius::Pixels(0).pixels(512, 512, 1.0), 0);
+        assert_eq!(GuidedRadius::Pixels(7).pixels(512, 512, 1.0), 7);
+    }
 
     #[test]
     fn regularized_inversion_is_exact_without_haze_and_bounded_at_t_min() {

@@ -6,27 +6,28 @@ use polar_imgproc::{Border, box_filter, guided_filter};
 use rayon::prelude::*;
 
 use crate::prep::Normalized;
-use crate::{DehazeError, DehazeOptions};
+use crate::{DehazeError, DehazeOptions, GuidedRadius};
 
 /// Fills the NaN entries of `raw` (unknown: invalid pixels), runs the guided filter of
-/// radius `opts.guided_radius` (skipped for 0) and regularisation `eps`, and clamps to
-/// `[t_min, 1]`. Every output value is finite.
+/// radius `opts.guided_radius` (skipped for 0 pixels; [`GuidedRadius::Adaptive`] measures
+/// the filled raw `t`'s pixel noise with [`plane_noise`]) and regularisation `eps`, and
+/// clamps to `[t_min, 1]`. Every output value is finite.
 pub fn refine(
     input: &Normalized,
     raw: &Gray<f32>,
     opts: &DehazeOptions,
     eps: f32,
 ) -> Result<Gray<f32>, DehazeError> {
-    let filled = fill_unknown(raw, opts.guided_radius.max(1))?;
-    let mut t = Gray::new(raw.width(), raw.height());
-    if opts.guided_radius > 0 {
-        guided_filter(
-            &input.s0,
-            &filled,
-            &mut t,
-            opts.guided_radius,
-            f64::from(eps),
-        )?;
+    let (w, h) = raw.size();
+    let filled = fill_unknown(raw, opts.guided_radius.base(w, h).max(1))?;
+    let t_noise = match opts.guided_radius {
+        GuidedRadius::Adaptive => plane_noise(&filled, &input.valid),
+        GuidedRadius::Pixels(_) => 0.0,
+    };
+    let radius = opts.guided_radius.pixels(w, h, t_noise);
+    let mut t = Gray::new(w, h);
+    if radius > 0 {
+        guided_filter(&input.s0, &filled, &mut t, radius, f64::from(eps))?;
     } else {
         t = filled;
     }
@@ -107,11 +108,16 @@ fn window_sums(
 /// deviation `6 sigma`; `sigma = 1.4826 median(|response|) / 6` over the 3x3 windows of
 /// valid pixels. 0 for a noiseless smooth image or one smaller than 3x3.
 pub fn noise_sigma(input: &Normalized) -> f32 {
-    let (w, h) = input.s0.size();
+    plane_noise(&input.s0, &input.valid)
+}
+
+/// [`noise_sigma`] of any plane over the pixels of `valid`.
+pub fn plane_noise(plane: &Gray<f32>, valid: &[bool]) -> f32 {
+    let (w, h) = plane.size();
     if w < 3 || h < 3 {
         return 0.0;
     }
-    let (s0, valid) = (input.s0.as_slice(), input.valid.as_slice());
+    let s0 = plane.as_slice();
     let rows: Vec<Vec<f32>> = (1..h - 1)
         .into_par_iter()
         .map(|y| row_responses(s0, valid, w, y))

@@ -1,12 +1,12 @@
 //! The dark-channel baseline against the independent OpenCV reference
 //! `tools/dehaze_dcp_reference.py` (cv2.erode, cv2.ximgproc.guidedFilter; numpy for the
 //! rest), on its closed-form synthetic hazy S0 (64x48, written by the script's
-//! `--synthetic`), with He et al.'s parameters (patch 15, omega 0.95, t0 0.1) and our
-//! guided filter defaults (radius 15, eps 1e-3). The regeneration command is in the script.
+//! `--synthetic`), with He et al.'s parameters (patch 15, omega 0.95, t0 0.1) and the
+//! script's guided filter (radius 15, eps 1e-3). The regeneration command is in the script.
 
 mod common;
 
-use polar_dehaze::{DehazeOptions, Method, dehaze};
+use polar_dehaze::{DehazeOptions, GuidedRadius, Method, dehaze};
 
 const W: usize = 64;
 const H: usize = 48;
@@ -27,6 +27,8 @@ fn dark_channel_matches_opencv_reference() {
     let obs = common::observation(W, H, s0.clone(), vec![0.0; W * H], vec![0.0; W * H]);
     let opts = DehazeOptions {
         method: Method::DarkChannel,
+        // The reference script's radius (He et al.'s filter as tools/ runs it).
+        guided_radius: GuidedRadius::Pixels(15),
         denoise_radius: 0,
         ..DehazeOptions::default()
     };

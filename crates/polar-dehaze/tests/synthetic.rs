@@ -5,13 +5,13 @@
 mod common;
 
 use common::{Haze, noise, observation};
-use polar_dehaze::{DehazeOptions, Method, WeakPolarization, dehaze};
+use polar_dehaze::{DehazeOptions, GuidedRadius, Method, WeakPolarization, dehaze};
 use polar_sensor::mask::SATURATED;
 
 /// Schechner et al.'s model as is: one `p` and `A_inf`, no guided filter, no denoising.
 fn unrefined() -> DehazeOptions {
     DehazeOptions {
-        guided_radius: 0,
+        guided_radius: GuidedRadius::Pixels(0),
         t_min: 0.05,
         varying_airlight: false,
         denoise_radius: 0,
@@ -155,15 +155,16 @@ fn sky_brighter_on_one_side_gets_a_varying_airlight() {
     let (t_one, l_one, _) = run(false);
     let (t_var, l_var, out) = run(true);
     // One A_inf (the brightest sky) takes the darker side for nearer than it is: t errs by
-    // 0.07 on average, the radiance by 0.05. The plane of A_inf halves the t error (0.033;
-    // what is left is the guided filter's and the p plane's, as in the tests above) and
-    // cuts the radiance error by a quarter (0.036; regularised inversion and denoising).
+    // 0.063 on average. The plane of A_inf cuts that to 0.008 (what is left is the guided
+    // filter's and the p plane's, as in the tests above). The radiance errs by 0.026 either
+    // way, most of it the regularised inversion's shrinkage and the denoising, which do not
+    // depend on A_inf: there the plane must not lose.
     assert!(
-        t_var < 0.6 * t_one,
+        t_var < 0.25 * t_one,
         "t error {t_var} vs {t_one} with one A_inf"
     );
     assert!(
-        l_var < 0.8 * l_one,
+        l_var <= l_one,
         "radiance error {l_var} vs {l_one} with one A_inf"
     );
     // The sky's S0 is A_inf itself: the plane follows it, so the sky keeps its brightness
@@ -401,4 +402,36 @@ fn method_names_round_trip_and_bad_options_are_errors() {
     ] {
         assert!(dehaze(&scene.observation(), &opts).is_err());
     }
+}
+
+#[test]
+fn noisy_transmission_widens_the_guided_window() {
+    // A flat frame and a raw t of 0.5 with uniform noise of deviation 0.05 / sqrt(3) =
+    // 0.029: the share of the frame (r = 3 at 96 pixels) averages 7 pixels a side, the
+    // adaptive radius widens the window to 15 (r = 7), where 0.029 / 15 < 0.002.
+    let (w, h) = (96, 96);
+    let obs = observation(w, h, vec![100.0; w * h], vec![0.0; w * h], vec![0.0; w * h]);
+    let input = polar_dehaze::prep::Normalized::new(&obs);
+    let raw: Vec<f32> = noise(41, w * h).iter().map(|n| 0.5 + 0.05 * n).collect();
+    let raw = polar_image::Gray::from_vec(w, h, raw).unwrap();
+    let spread = |guided_radius| {
+        let opts = DehazeOptions {
+            guided_radius,
+            ..DehazeOptions::default()
+        };
+        let t = polar_dehaze::refine::refine(&input, &raw, &opts, opts.guided_eps).unwrap();
+        let v = t.as_slice();
+        (v.iter().map(|t| (t - 0.5).powi(2)).sum::<f32>() / v.len() as f32).sqrt()
+    };
+    let base = GuidedRadius::Adaptive.base(w, h);
+    let (fixed, adaptive) = (
+        spread(GuidedRadius::Pixels(base)),
+        spread(GuidedRadius::Adaptive),
+    );
+    // Independent noise averaged over (2r+1)^2 pixels: 7 -> 15 pixels a side, 2.1x less
+    // (measured 2.3x: the guided filter averages twice).
+    assert!(
+        adaptive < 0.6 * fixed,
+        "t noise {adaptive} vs {fixed} at r = {base}"
+    );
 }
