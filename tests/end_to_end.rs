@@ -33,9 +33,19 @@ use polar_io::files::{self, vision};
 
 /// Runs `eval` on `families` of the ci suite with `tasks` and returns its metrics.json.
 fn eval(families: &str, tasks: &str, jobs: &str) -> (tempfile::TempDir, serde_json::Value) {
+    eval_with(families, tasks, jobs, &[])
+}
+
+/// [`eval`] with more options.
+fn eval_with(
+    families: &str,
+    tasks: &str,
+    jobs: &str,
+    options: &[&str],
+) -> (tempfile::TempDir, serde_json::Value) {
     let out = tempfile::tempdir().unwrap();
     let data = standard_ci();
-    let ok = vision(&[
+    let mut args = vec![
         "eval",
         arg(data),
         "--out",
@@ -46,8 +56,9 @@ fn eval(families: &str, tasks: &str, jobs: &str) -> (tempfile::TempDir, serde_js
         tasks,
         "--jobs",
         jobs,
-    ])
-    .expect("eval completes");
+    ];
+    args.extend_from_slice(options);
+    let ok = vision(&args).expect("eval completes");
     assert!(
         ok,
         "a task failed on {families}: see {}",
@@ -272,33 +283,42 @@ fn worst_sfp_samples_are_shown(out: &std::path::Path, m: &serde_json::Value) {
 #[test]
 fn dehazing_on_the_ci_haze_family() {
     let (_dir, m) = eval("haze", "dehaze", "2");
-    let key = |k: &str| family_mean(&m, "haze", "dehaze", k);
+    let (_dcp_dir, dcp) = eval_with("haze", "dehaze", "2", &["--dehaze-method", "dark-channel"]);
+    let key = |m: &serde_json::Value, k: &str| family_mean(m, "haze", "dehaze", k);
     let (dehazed, hazy) = (
-        key("against_dehazed.dehazed.psnr_db"),
-        key("against_dehazed.hazy.psnr_db"),
+        key(&m, "against_dehazed.dehazed.psnr_db"),
+        key(&m, "against_dehazed.hazy.psnr_db"),
     );
-    let corr = key("against_dehazed.transmission_correlation");
-    let (reach_dehazed, reach_hazy) = (
-        key("against_dehazed.reachable.dehazed_psnr_db"),
-        key("against_dehazed.reachable.hazy_psnr_db"),
+    let corr = key(&m, "against_dehazed.transmission_correlation");
+    let reach = |m: &serde_json::Value, k: &str| key(m, &format!("against_dehazed.reachable.{k}"));
+    let (reach_dehazed, reach_hazy, reach_dcp) = (
+        reach(&m, "dehazed_psnr_db"),
+        reach(&m, "hazy_psnr_db"),
+        reach(&dcp, "dehazed_psnr_db"),
     );
     eprintln!(
         "haze ci: dehazed {dehazed:.2} dB, hazy {hazy:.2} dB, transmission r {corr:.3}; \
-         reachable pixels: dehazed {reach_dehazed:.2} dB, hazy {reach_hazy:.2} dB"
+         reachable pixels: dehazed {reach_dehazed:.2} dB, hazy {reach_hazy:.2} dB, \
+         dark channel {reach_dcp:.2} dB"
     );
-    // Targets on the full family: +4 dB over the hazy input, r >= 0.9 (the dev set's figures
-    // are in docs/benchmarks.md; the sky decides the whole frame). The two 64x64 ci samples
-    // at 8 spp are far noisier (1/t amplifies their noise), so here the output must not lose
-    // more than 1 dB and t must follow the truth.
-    assert!(dehazed > hazy - 1.0, "dehazed {dehazed} dB, hazy {hazy} dB");
-    assert!(corr > 0.8, "transmission correlation {corr}");
-    // The pixels whose radiance the image holds (true t >= 0.1) are scored apart (the
-    // lookups above fail if no sample has any): there too the output must not lose more
-    // than 1 dB.
+    // The targets, on the pixels whose radiance the image holds (true t >= 0.1; the lookups
+    // fail if no sample has any): +4 dB over the hazy input and +2 dB over the dark
+    // channel on average, transmission correlation >= 0.9. The two 64x64 samples render
+    // the haze at 512 spp as the full family does; they score +8.2 and +1.9 dB (mean +5.1),
+    // r 0.97, and the dark channel 15 dB below the input, so a regression of the
+    // transmission or the airlight shows here.
     assert!(
-        reach_dehazed > reach_hazy - 1.0,
+        reach_dehazed >= reach_hazy + 4.0,
         "reachable pixels: dehazed {reach_dehazed} dB, hazy {reach_hazy} dB"
     );
+    assert!(
+        reach_dehazed >= reach_dcp + 2.0,
+        "reachable pixels: dehazed {reach_dehazed} dB, dark channel {reach_dcp} dB"
+    );
+    assert!(corr >= 0.9, "transmission correlation {corr}");
+    // The whole frame also holds the sky behind the haze (gt/dehazed shows the haze-free
+    // sky, which no dehazer sees): +1.3 dB here, +1.9 on the dev family; it must not lose.
+    assert!(dehazed > hazy, "dehazed {dehazed} dB, hazy {hazy} dB");
 }
 
 #[test]
