@@ -8,6 +8,10 @@ use rayon::prelude::*;
 use crate::prep::Normalized;
 use crate::{DehazeError, DehazeOptions, GuidedRadius};
 
+/// The raw transmission's noise is measured on about this many rows at most, evenly spaced
+/// (the median of their responses: more rows only cost time).
+pub const NOISE_ROWS: usize = 512;
+
 /// Fills the NaN entries of `raw` (unknown: invalid pixels), runs the guided filter of
 /// radius `opts.guided_radius` (skipped for 0 pixels; [`GuidedRadius::Adaptive`] measures
 /// the filled raw `t`'s pixel noise with [`plane_noise`]) and regularisation `eps`, and
@@ -21,7 +25,7 @@ pub fn refine(
     let (w, h) = raw.size();
     let filled = fill_unknown(raw, opts.guided_radius.base(w, h).max(1))?;
     let t_noise = match opts.guided_radius {
-        GuidedRadius::Adaptive => plane_noise(&filled, &input.valid),
+        GuidedRadius::Adaptive => plane_noise(&filled, &input.valid, h.div_ceil(NOISE_ROWS)),
         GuidedRadius::Pixels(_) => 0.0,
     };
     let radius = opts.guided_radius.pixels(w, h, t_noise);
@@ -108,11 +112,11 @@ fn window_sums(
 /// deviation `6 sigma`; `sigma = 1.4826 median(|response|) / 6` over the 3x3 windows of
 /// valid pixels. 0 for a noiseless smooth image or one smaller than 3x3.
 pub fn noise_sigma(input: &Normalized) -> f32 {
-    plane_noise(&input.s0, &input.valid)
+    plane_noise(&input.s0, &input.valid, 1)
 }
 
-/// [`noise_sigma`] of any plane over the pixels of `valid`.
-pub fn plane_noise(plane: &Gray<f32>, valid: &[bool]) -> f32 {
+/// [`noise_sigma`] of any plane over the pixels of `valid`, from every `row_step`-th row.
+pub fn plane_noise(plane: &Gray<f32>, valid: &[bool], row_step: usize) -> f32 {
     let (w, h) = plane.size();
     if w < 3 || h < 3 {
         return 0.0;
@@ -120,6 +124,7 @@ pub fn plane_noise(plane: &Gray<f32>, valid: &[bool]) -> f32 {
     let s0 = plane.as_slice();
     let rows: Vec<Vec<f32>> = (1..h - 1)
         .into_par_iter()
+        .step_by(row_step.max(1))
         .map(|y| row_responses(s0, valid, w, y))
         .collect();
     polar_image::quantile(rows.iter().flatten().copied(), 0.5).map_or(0.0, |med| 1.4826 * med / 6.0)
