@@ -147,8 +147,7 @@ impl GuidedRadius {
     /// (standard deviation; ignored by [`GuidedRadius::Pixels`]).
     pub fn pixels(self, w: usize, h: usize, t_noise: f32) -> usize {
         let base = self.base(w, h);
-        let noisy = t_noise.partial_cmp(&Self::NOISE_TARGET) == Some(std::cmp::Ordering::Greater);
-        if self != GuidedRadius::Adaptive || !noisy {
+        if self != GuidedRadius::Adaptive || t_noise.is_nan() || t_noise <= Self::NOISE_TARGET {
             return base;
         }
         let for_noise = ((t_noise / Self::NOISE_TARGET - 1.0) / 2.0).ceil() as usize;

@@ -4,7 +4,8 @@
 //! Every feature is scale-free (S0 enters only divided by the frame's robust scale) and
 //! computed with the cues of [`crate::prepare`]: from the normals and object mask of shape
 //! from polarization where given, as `polar-vision train` gives them at training and `run`
-//! at inference, else from the silhouettes; give a model the cues it was trained with.
+//! at inference, else from the silhouettes. The features differ with the cues, so a model
+//! holds only for the kind of cues it was trained with.
 
 use polar_image::{Gray, NormalImage, par_map};
 use polar_imgproc::{Border, box_filter};
