@@ -50,18 +50,24 @@ def material_case(pred, truth):
             "confusion": cm.tolist()}
 
 
-def dehaze_case(hazy, dehazed, ref, t_est, t_gt):
+def dehaze_case(hazy, dehazed, ref, t_est, t_gt, labels):
     r = float(ref.max())
-    score = lambda x: {"psnr_db": peak_signal_noise_ratio(ref, x, data_range=r),
-                       "ssim": structural_similarity(ref, x, data_range=r, gaussian_weights=True,
-                                                     sigma=1.5, use_sample_covariance=False)}
-    reach = t_gt >= REACHABLE_T
-    mse = lambda x: np.mean((x[reach] - ref[reach]).astype(np.float64) ** 2)
+    ssim = lambda x: structural_similarity(ref, x, data_range=r, gaussian_weights=True, sigma=1.5,
+                                           use_sample_covariance=False, full=True)
+    score = lambda x: {"psnr_db": peak_signal_noise_ratio(ref, x, data_range=r), "ssim": ssim(x)[0]}
+    psnr_over = lambda x, m: 10 * np.log10(r * r / np.mean((x[m] - ref[m]).astype(np.float64) ** 2))
+    mae = lambda m: float(np.mean(np.abs(t_est[m].astype(np.float64) - t_gt[m])))
+    corr = lambda m: float(np.corrcoef(t_est[m], t_gt[m])[0, 1])
+    reach, obj = t_gt >= REACHABLE_T, labels != 0
+    object_score = lambda x: {"psnr_db": psnr_over(x, obj), "ssim": float(np.mean(ssim(x)[1][obj]))}
+    everywhere = np.ones_like(reach)
     return {"hazy": score(hazy), "dehazed": score(dehazed),
-            "transmission_mae": float(np.mean(np.abs(t_est.astype(np.float64) - t_gt))),
-            "transmission_correlation": float(np.corrcoef(t_est.ravel(), t_gt.ravel())[0, 1]),
-            "reachable": {"fraction": reach.mean(), "hazy_psnr_db": 10 * np.log10(r * r / mse(hazy)),
-                          "dehazed_psnr_db": 10 * np.log10(r * r / mse(dehazed))}}
+            "transmission_mae": mae(everywhere), "transmission_correlation": corr(everywhere),
+            "reachable": {"fraction": reach.mean(), "hazy_psnr_db": psnr_over(hazy, reach),
+                          "dehazed_psnr_db": psnr_over(dehazed, reach)},
+            "objects": {"fraction": obj.mean(), "hazy": object_score(hazy),
+                        "dehazed": object_score(dehazed), "transmission_mae": mae(obj),
+                        "transmission_correlation": corr(obj)}}
 
 
 def make():
@@ -81,17 +87,19 @@ def make():
     dehazed = f32(ref + 0.05 * rng.standard_normal((H, W)))
     t_gt = f32(rng.random((H, W)))
     t_est = f32(np.clip(t_gt + 0.1 * rng.standard_normal((H, W)), 0.05, 1.0))
+    object_labels = (rng.random((H, W)) > 0.7).astype(np.uint8) * rng.integers(1, 4, (H, W)).astype(np.uint8)
     arr = lambda a: np.where(np.isfinite(a), a, None).ravel().tolist() if a.dtype.kind == "f" else a.ravel().tolist()
     return {
         "width": W, "height": H,
         "inputs": {"gt_depth": arr(gt_depth), "est_depth": arr(est_depth), "depth_mask": arr(dmask),
                    "truth_mask": arr(truth_m), "pred_mask": arr(pred_m), "distractors": arr(distr),
                    "truth_labels": arr(truth_l), "pred_labels": arr(pred_l), "reference": arr(ref),
-                   "hazy": arr(hazy), "dehazed": arr(dehazed), "t_gt": arr(t_gt), "t_est": arr(t_est)},
+                   "hazy": arr(hazy), "dehazed": arr(dehazed), "t_gt": arr(t_gt), "t_est": arr(t_est),
+                   "object_labels": arr(object_labels)},
         "expected": {"depth": depth_fit(est_depth, gt_depth, dmask),
                      "mask": mask_case(pred_m, truth_m, distr),
                      "material": material_case(pred_l, truth_l),
-                     "dehaze": dehaze_case(hazy, dehazed, ref, t_est, t_gt)},
+                     "dehaze": dehaze_case(hazy, dehazed, ref, t_est, t_gt, object_labels)},
     }
 
 

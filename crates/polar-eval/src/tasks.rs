@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use polar_image::{Gray, NormalImage};
-use polar_imgproc::{AngularErrorStats, ConfusionMatrix, angular_error, psnr, ssim};
+use polar_imgproc::{AngularErrorStats, ConfusionMatrix, angular_error, psnr, ssim, ssim_map};
 use serde::{Deserialize, Serialize};
 
 use crate::depth::{DepthFit, depth_fit};
@@ -203,6 +203,8 @@ pub struct DehazeMetrics {
     /// PSNR over the pixels whose radiance the image still holds (true transmission at
     /// least [`REACHABLE_TRANSMISSION`]), where the truth is known and such pixels exist.
     pub reachable: Option<ReachableScore>,
+    /// The scores over the object pixels, where the labels are known and hold any.
+    pub objects: Option<ObjectScore>,
 }
 
 /// Pixels whose true transmission is below this are left out of [`ReachableScore`]: less
@@ -223,77 +225,154 @@ pub struct ReachableScore {
     pub dehazed_psnr_db: f64,
 }
 
-/// Scores a dehazing result over the whole frame. The data range of PSNR and SSIM is the
-/// reference's maximum (at least the smallest positive float), so a scale-free score.
+/// The hazy input and the dehazed output over the object pixels (`gt/material.png` label
+/// not 0), what the scene holds in front of the haze whatever its sky does: PSNR with the
+/// whole frame's data range, SSIM the mean of the frame's SSIM map over those pixels, and
+/// the transmission's error there.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ObjectScore {
+    /// Share of the frame's pixels that are object pixels.
+    pub fraction: f64,
+    /// Hazy S0 against the reference.
+    pub hazy: ImageScore,
+    /// Dehazed radiance against the reference.
+    pub dehazed: ImageScore,
+    /// Mean absolute transmission error, where the truth is known.
+    pub transmission_mae: Option<f64>,
+    /// Pearson correlation of estimated and true transmission.
+    pub transmission_correlation: Option<f64>,
+}
+
+/// Scores a dehazing result over the whole frame, the reachable pixels (where the true
+/// transmission is given) and the object pixels (where `labels` are given, 0 = none). The
+/// data range of PSNR and SSIM is the reference's maximum (at least the smallest positive
+/// float), so a scale-free score.
 pub fn dehaze_metrics(
     hazy: &Gray<f32>,
     dehazed: &Gray<f32>,
     reference: &Gray<f32>,
     transmission: Option<(&Gray<f32>, &Gray<f32>)>,
+    labels: Option<&Gray<u8>>,
 ) -> Result<DehazeMetrics, EvalError> {
     check_size("dehazed", dehazed.size(), reference.size())?;
     check_size("hazy", hazy.size(), reference.size())?;
+    if let Some(l) = labels {
+        check_size("labels", l.size(), reference.size())?;
+    }
+    if let Some((est, gt)) = transmission {
+        check_size("transmission", est.size(), gt.size())?;
+        check_size("true transmission", gt.size(), reference.size())?;
+    }
     let range = reference
         .as_slice()
         .iter()
         .copied()
         .filter(|v| v.is_finite())
         .fold(f32::MIN_POSITIVE, f32::max) as f64;
-    let score = |img: &Gray<f32>| -> Result<ImageScore, EvalError> {
-        Ok(ImageScore {
-            psnr_db: psnr(reference, img, range)?,
-            ssim: ssim(reference, img, range)?,
-        })
+    let pair = Pair {
+        hazy,
+        dehazed,
+        reference,
+        range,
     };
-    let (mae, corr, reachable) = match transmission {
-        Some((est, gt)) => {
-            check_size("transmission", est.size(), gt.size())?;
-            check_size("true transmission", gt.size(), reference.size())?;
-            let n = est.as_slice().len().max(1) as f64;
-            let mae = est
-                .as_slice()
-                .iter()
-                .zip(gt.as_slice())
-                .map(|(a, b)| f64::from((a - b).abs()))
-                .sum::<f64>()
-                / n;
-            let reachable = reachable_score(hazy, dehazed, reference, gt, range);
-            (Some(mae), pearson(est.as_slice(), gt.as_slice()), reachable)
-        }
-        None => (None, None, None),
+    let t_error = |keep: &[usize]| transmission.map(|(est, gt)| transmission_error(est, gt, keep));
+    let reachable = transmission.and_then(|(_, gt)| pair.reachable(gt));
+    let objects = match labels.map(|l| pixels_where(l.as_slice(), |v| v != 0)) {
+        Some(keep) if !keep.is_empty() => Some(pair.objects(&keep, t_error(&keep))?),
+        _ => None,
     };
+    let all: Vec<usize> = (0..reference.as_slice().len()).collect();
+    let error = t_error(&all);
     Ok(DehazeMetrics {
-        hazy: score(hazy)?,
-        dehazed: score(dehazed)?,
-        transmission_mae: mae,
-        transmission_correlation: corr,
+        hazy: pair.whole(hazy)?,
+        dehazed: pair.whole(dehazed)?,
+        transmission_mae: error.map(|e| e.0),
+        transmission_correlation: error.and_then(|e| e.1),
         reachable,
+        objects,
     })
 }
 
-/// [`ReachableScore`] of same-sized images; `None` where no pixel is reachable.
-fn reachable_score(
-    hazy: &Gray<f32>,
-    dehazed: &Gray<f32>,
-    reference: &Gray<f32>,
-    t_true: &Gray<f32>,
+/// The hazy input and the dehazed output of one frame, its reference and the data range.
+struct Pair<'a> {
+    hazy: &'a Gray<f32>,
+    dehazed: &'a Gray<f32>,
+    reference: &'a Gray<f32>,
     range: f64,
-) -> Option<ReachableScore> {
-    let keep: Vec<usize> = (t_true.as_slice().iter().enumerate())
-        .filter(|(_, t)| **t >= REACHABLE_TRANSMISSION)
-        .map(|(k, _)| k)
-        .collect();
-    let r = reference.as_slice();
-    let psnr = |img: &Gray<f32>| {
-        let x = img.as_slice();
+}
+
+impl Pair<'_> {
+    /// PSNR and SSIM of `img` over the whole frame.
+    fn whole(&self, img: &Gray<f32>) -> Result<ImageScore, EvalError> {
+        Ok(ImageScore {
+            psnr_db: psnr(self.reference, img, self.range)?,
+            ssim: ssim(self.reference, img, self.range)?,
+        })
+    }
+
+    /// PSNR (dB) of `img` over the pixels `keep` (not empty).
+    fn psnr_over(&self, img: &Gray<f32>, keep: &[usize]) -> f64 {
+        let (r, x) = (self.reference.as_slice(), img.as_slice());
         let sse: f64 = keep.iter().map(|&k| f64::from(x[k] - r[k]).powi(2)).sum();
-        10.0 * (range * range * keep.len() as f64 / sse).log10()
-    };
-    (!keep.is_empty()).then(|| ReachableScore {
-        fraction: keep.len() as f64 / r.len() as f64,
-        hazy_psnr_db: psnr(hazy),
-        dehazed_psnr_db: psnr(dehazed),
-    })
+        10.0 * (self.range * self.range * keep.len() as f64 / sse).log10()
+    }
+
+    /// PSNR and the mean of the SSIM map of `img` over the pixels `keep` (not empty).
+    fn over(&self, img: &Gray<f32>, keep: &[usize]) -> Result<ImageScore, EvalError> {
+        let (w, h) = self.reference.size();
+        let mut map = Gray::new(w, h);
+        ssim_map(self.reference, img, self.range, &mut map)?;
+        let m = map.as_slice();
+        Ok(ImageScore {
+            psnr_db: self.psnr_over(img, keep),
+            ssim: keep.iter().map(|&k| f64::from(m[k])).sum::<f64>() / keep.len() as f64,
+        })
+    }
+
+    /// [`ReachableScore`] for the true transmission `t_true`; `None` where no pixel is
+    /// reachable.
+    fn reachable(&self, t_true: &Gray<f32>) -> Option<ReachableScore> {
+        let keep = pixels_where(t_true.as_slice(), |t| t >= REACHABLE_TRANSMISSION);
+        (!keep.is_empty()).then(|| ReachableScore {
+            fraction: keep.len() as f64 / t_true.as_slice().len() as f64,
+            hazy_psnr_db: self.psnr_over(self.hazy, &keep),
+            dehazed_psnr_db: self.psnr_over(self.dehazed, &keep),
+        })
+    }
+
+    /// [`ObjectScore`] over the object pixels `keep` (not empty), with the transmission's
+    /// error there.
+    fn objects(
+        &self,
+        keep: &[usize],
+        t_error: Option<(f64, Option<f64>)>,
+    ) -> Result<ObjectScore, EvalError> {
+        Ok(ObjectScore {
+            fraction: keep.len() as f64 / self.reference.as_slice().len() as f64,
+            hazy: self.over(self.hazy, keep)?,
+            dehazed: self.over(self.dehazed, keep)?,
+            transmission_mae: t_error.map(|e| e.0),
+            transmission_correlation: t_error.and_then(|e| e.1),
+        })
+    }
+}
+
+/// Indices of the values for which `keep` holds.
+fn pixels_where<T: Copy>(v: &[T], keep: impl Fn(T) -> bool) -> Vec<usize> {
+    (0..v.len()).filter(|&k| keep(v[k])).collect()
+}
+
+/// Mean absolute error and Pearson correlation of the estimated transmission over `keep`.
+fn transmission_error(est: &Gray<f32>, gt: &Gray<f32>, keep: &[usize]) -> (f64, Option<f64>) {
+    let (e, g) = (est.as_slice(), gt.as_slice());
+    let n = keep.len().max(1) as f64;
+    let mae = keep
+        .iter()
+        .map(|&k| f64::from((e[k] - g[k]).abs()))
+        .sum::<f64>()
+        / n;
+    let (es, gs): (Vec<f32>, Vec<f32>) = keep.iter().map(|&k| (e[k], g[k])).unzip();
+    (mae, pearson(&es, &gs))
 }
 
 /// Pearson correlation of two equally long series over the pairs where both are finite;
@@ -371,7 +450,7 @@ mod tests {
         let mut t = vec![1.0f32; n];
         (t[0], t[1]) = (0.05, 0.5);
         let t = gray(12, t);
-        let m = dehaze_metrics(&hazy, &dehazed, &reference, Some((&t, &t))).unwrap();
+        let m = dehaze_metrics(&hazy, &dehazed, &reference, Some((&t, &t)), None).unwrap();
         let r = m.reachable.unwrap();
         assert_eq!(r.fraction, 143.0 / 144.0);
         let want = |sse: f64| 10.0 * (143.0 / sse).log10();
@@ -379,8 +458,54 @@ mod tests {
         assert!((r.hazy_psnr_db - want(143.0 * 0.04)).abs() < 1e-4, "{r:?}");
         assert!(m.dehazed.psnr_db < r.dehazed_psnr_db - 10.0);
         let hidden = gray(12, vec![0.0f32; n]);
-        let m = dehaze_metrics(&hazy, &dehazed, &reference, Some((&t, &hidden))).unwrap();
+        let m = dehaze_metrics(&hazy, &dehazed, &reference, Some((&t, &hidden)), None).unwrap();
         assert_eq!(m.reachable, None);
+    }
+
+    #[test]
+    fn object_score_counts_only_labelled_pixels() {
+        // 12x12: the output is off by 0.5 on the 4 object pixels (labels 1-3) and by 1 on
+        // one background pixel, which must not count; no labelled pixel gives no score.
+        let n = 144;
+        let reference = gray(12, vec![1.0f32; n]);
+        let hazy = gray(12, vec![0.8f32; n]);
+        let mut dehazed = vec![1.0f32; n];
+        let mut labels = vec![0u8; n];
+        for (k, l) in [(30, 1u8), (31, 2), (42, 3), (43, 1)] {
+            (dehazed[k], labels[k]) = (0.5, l);
+        }
+        dehazed[100] = 0.0;
+        let (dehazed, labels) = (gray(12, dehazed), gray(12, labels));
+        let t_true = gray(12, vec![0.5f32; n]);
+        let mut t_est = vec![0.5f32; n];
+        t_est[30] = 0.9;
+        let t_est = gray(12, t_est);
+        let m = dehaze_metrics(
+            &hazy,
+            &dehazed,
+            &reference,
+            Some((&t_est, &t_true)),
+            Some(&labels),
+        )
+        .unwrap();
+        let o = m.objects.unwrap();
+        assert_eq!(o.fraction, 4.0 / 144.0);
+        assert!(
+            (o.dehazed.psnr_db - 10.0 * (1.0f64 / 0.25).log10()).abs() < 1e-9,
+            "{o:?}"
+        );
+        assert!(
+            (o.hazy.psnr_db - 10.0 * (1.0f64 / 0.04).log10()).abs() < 1e-4,
+            "{o:?}"
+        );
+        assert!(
+            o.dehazed.ssim < 1.0 && o.dehazed.ssim < m.dehazed.ssim,
+            "{o:?}"
+        );
+        assert!((o.transmission_mae.unwrap() - 0.1).abs() < 1e-6, "{o:?}");
+        let none = gray(12, vec![0u8; n]);
+        let m = dehaze_metrics(&hazy, &dehazed, &reference, None, Some(&none)).unwrap();
+        assert_eq!(m.objects, None);
     }
 
     #[test]

@@ -147,6 +147,7 @@ fn dehaze_metrics_match_scikit_image_and_numpy() {
         &g.f32("dehazed"),
         &g.f32("reference"),
         Some((&t_est, &t_gt)),
+        Some(&g.u8("object_labels")),
     )
     .unwrap();
     assert_rel(
@@ -200,5 +201,23 @@ fn dehaze_metrics_match_scikit_image_and_numpy() {
     ] {
         let want = g.expected(&format!("dehaze.reachable.{key}"));
         assert_rel(got, want, 1e-9, key);
+    }
+    // Over the object pixels: the mean of the SSIM map there (scikit-image's `full=True`).
+    let o = m.objects.expect("some object labels");
+    let objects = [
+        (o.fraction, "fraction", 1e-12),
+        (o.hazy.psnr_db, "hazy.psnr_db", 1e-9),
+        (o.dehazed.psnr_db, "dehazed.psnr_db", 1e-9),
+        (o.hazy.ssim, "hazy.ssim", 1e-5),
+        (o.dehazed.ssim, "dehazed.ssim", 1e-5),
+        (o.transmission_mae.unwrap(), "transmission_mae", 1e-9),
+        (
+            o.transmission_correlation.unwrap(),
+            "transmission_correlation",
+            1e-9,
+        ),
+    ];
+    for (got, key, tol) in objects {
+        assert_rel(got, g.expected(&format!("dehaze.objects.{key}")), tol, key);
     }
 }

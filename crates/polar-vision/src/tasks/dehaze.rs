@@ -49,7 +49,8 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
             ("against_clear", &ctx.gt.clear),
         ] {
             if let Some(reference) = reference {
-                let m = dehaze_metrics(&hazy, &dehazed, reference, t)
+                let labels = ctx.gt.material.as_ref();
+                let m = dehaze_metrics(&hazy, &dehazed, reference, t, labels)
                     .map_err(|e| Failure::CannotRun(e.to_string()))?;
                 metrics.insert(key.to_owned(), to_json(&m)?);
             }
