@@ -237,46 +237,73 @@ fn per_class_iou_is_summarised(out: &std::path::Path) {
 }
 
 /// summary.md lists the sfp samples with the largest mean error, largest first, each with
-/// its picture (S0 | estimate | truth | error: four panels as wide as the sample), and
-/// every sample's metrics say which index was used and carry the fitted light.
+/// its picture (S0 | estimate | truth | error: four panels), and every sample's metrics say
+/// which index was used and carry the fitted light.
 fn worst_sfp_samples_are_shown(out: &std::path::Path, m: &serde_json::Value) {
-    let mut by_error: Vec<(f64, String)> = m["samples"]
-        .as_object()
-        .unwrap()
-        .iter()
-        .map(|(name, r)| {
-            let sfp = &r["Ok"]["tasks"]["sfp"]["metrics"];
-            assert_eq!(sfp["ior"]["source"], "default", "{name}");
-            assert!(sfp["light"]["direction"].is_array(), "{name}: {sfp}");
-            (sfp["normal"]["mean_deg"].as_f64().unwrap(), name.clone())
-        })
-        .collect();
-    by_error.sort_by(|a, b| b.0.total_cmp(&a.0));
-    by_error.truncate(5);
-    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
-    let section = summary
-        .split_once("largest mean angular error")
-        .expect("summary.md has the worst-samples section")
-        .1;
-    let listed: Vec<&str> = section
-        .lines()
-        .filter_map(|l| l.strip_prefix("| sfp-"))
-        .collect();
-    assert_eq!(listed.len(), by_error.len(), "{section}");
-    for (rank, ((_, name), line)) in by_error.iter().zip(&listed).enumerate() {
-        assert!(
-            format!("sfp-{line}").starts_with(&format!("{name} ")),
-            "{line}"
-        );
-        let picture = out.join(format!("pictures/worst-sfp-{}-{name}.png", rank + 1));
-        assert!(line.contains(&format!("worst-sfp-{}-{name}.png", rank + 1)));
-        let png = polar_io::read_rgb8_png(&picture).unwrap();
-        let normal: polar_image::NormalImage = polar_io::read_exr(
-            out.join("samples").join(name).join(vision::NORMAL),
-            polar_io::RGB_CHANNELS,
-        )
-        .unwrap();
-        assert_eq!(png.size(), (4 * normal.width(), normal.height()));
+    for (name, r) in m["samples"].as_object().unwrap() {
+        let sfp = &r["Ok"]["tasks"]["sfp"]["metrics"];
+        assert_eq!(sfp["ior"]["source"], "default", "{name}");
+        assert!(sfp["light"]["direction"].is_array(), "{name}: {sfp}");
+    }
+    let worst = Worst {
+        task: "sfp",
+        key: &["normal", "mean_deg"],
+        larger_is_worse: true,
+        heading: "largest mean angular error",
+        panels: 4,
+    };
+    worst.is_shown(out, m);
+}
+
+/// A task's worst samples as summary.md must list them.
+struct Worst<'a> {
+    task: &'a str,
+    /// Path of the ranking figure in the task's metrics.
+    key: &'a [&'a str],
+    larger_is_worse: bool,
+    /// Words of the section's heading.
+    heading: &'a str,
+    /// Panels of the picture, each as wide as the sample.
+    panels: usize,
+}
+
+impl Worst<'_> {
+    /// The five worst samples by the figure, worst first, each listed in the section with
+    /// its picture copied to `pictures/worst-<task>-<rank>-<name>.png`.
+    fn is_shown(&self, out: &std::path::Path, m: &serde_json::Value) {
+        let mut ranked: Vec<(f64, String)> = m["samples"]
+            .as_object()
+            .unwrap()
+            .iter()
+            .filter_map(|(name, r)| {
+                let metrics = &r["Ok"]["tasks"][self.task]["metrics"];
+                let v = self.key.iter().fold(metrics, |v, k| &v[*k]).as_f64()?;
+                Some((if self.larger_is_worse { -v } else { v }, name.clone()))
+            })
+            .collect();
+        ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        ranked.truncate(5);
+        assert!(!ranked.is_empty(), "no {} figures", self.task);
+        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        let section = summary
+            .split_once(self.heading)
+            .unwrap_or_else(|| panic!("summary.md has no section {:?}", self.heading))
+            .1;
+        let section = section.split("\n## ").next().unwrap();
+        let listed: Vec<&str> = section
+            .lines()
+            .filter(|l| l.starts_with("| ") && !l.starts_with("| sample "))
+            .collect();
+        assert_eq!(listed.len(), ranked.len(), "{section}");
+        for (rank, ((_, name), line)) in ranked.iter().zip(&listed).enumerate() {
+            assert!(line.starts_with(&format!("| {name} ")), "{line}");
+            let file = format!("pictures/worst-{}-{}-{name}.png", self.task, rank + 1);
+            assert!(line.contains(&file), "{line}");
+            let png = polar_io::read_rgb8_png(out.join(&file)).unwrap();
+            let stokes = out.join("samples").join(name).join(vision::STOKES);
+            let s0 = polar_io::read_exr_channel(stokes, "S0").unwrap();
+            assert_eq!(png.size(), (self.panels * s0.width(), s0.height()));
+        }
     }
 }
 
@@ -341,10 +368,18 @@ fn material_classification_on_the_ci_material_family() {
 
 #[test]
 fn transparency_on_the_ci_glass_family() {
-    let (_dir, m) = eval("glass", "transparent", "2");
+    let (dir, m) = eval("glass", "transparent", "2");
     let iou = family_mean(&m, "glass", "transparent", "iou");
     eprintln!("glass ci: IoU {iou:.3}");
     assert!(iou > TRANSPARENT_CI_IOU, "IoU {iou}");
+    let worst = Worst {
+        task: "transparent",
+        key: &["iou"],
+        larger_is_worse: false,
+        heading: "smallest mask IoU",
+        panels: 2,
+    };
+    worst.is_shown(dir.path(), &m);
 }
 
 #[test]

@@ -109,6 +109,9 @@ pub mod files {
             pub const MATERIAL: &str = "material.png";
             /// Transparency overlay.
             pub const TRANSPARENT: &str = "transparent.png";
+            /// S0 beside the transparency mask against the truth: found, false and missed
+            /// pixels (only where the sample has `gt/transparent.png`).
+            pub const TRANSPARENT_ERROR: &str = "transparent_error.png";
             /// Hazy, dehazed and transmission side by side.
             pub const DEHAZE: &str = "dehaze.png";
         }

@@ -67,7 +67,7 @@ pub struct EvalRunArgs {
     pub read: crate::input::InputArgs,
     /// Options of the tasks.
     #[command(flatten)]
-    pub task: crate::task_options::TaskArgs,
+    task: crate::task_options::TaskArgs,
 }
 
 impl EvalRunArgs {
@@ -274,8 +274,8 @@ fn read_records(dir: &Path) -> Result<Vec<(String, Record)>, CliError> {
     Ok(out)
 }
 
-/// Writes metrics.json and summary.md into `out`, with the pictures of the worst sfp
-/// samples copied from their output folders `dirs` (sample name -> folder).
+/// Writes metrics.json and summary.md into `out`, with the pictures of each task's worst
+/// samples ([`WORST`]) copied from their output folders `dirs` (sample name -> folder).
 fn write_report(
     out: &Path,
     samples: BTreeMap<String, Result<SampleReport, String>>,
@@ -291,9 +291,13 @@ fn write_report(
         samples,
     };
     polar_io::write_json(out.join(files::vision::METRICS), &report)?;
-    let worst = worst_sfp(&report);
-    let pictures = copy_worst_pictures(out, dirs, &worst)?;
-    let summary = summary_markdown(&report) + &worst_markdown(&worst, &pictures);
+    remove_worst_pictures(out)?;
+    let mut summary = summary_markdown(&report);
+    for of in &WORST {
+        let worst = worst_samples(&report, of);
+        let pictures = copy_worst_pictures(out, dirs, of, &worst)?;
+        summary += &worst_markdown(of, &worst, &pictures);
+    }
     std::fs::write(out.join("summary.md"), summary)
         .map_err(|e| CliError::write(out.join("summary.md"), e))?;
     Ok(report)
@@ -400,59 +404,130 @@ pub fn summary_markdown(report: &EvalReport) -> String {
     s
 }
 
-/// How many sfp samples summary.md shows as the worst.
-pub const WORST_SFP: usize = 5;
+/// How many samples per task summary.md shows as the worst.
+pub const WORST_SAMPLES: usize = 5;
 
-/// The sfp metrics (`normal` of `metrics.json`) of the [`WORST_SFP`] samples with the
-/// largest mean angular error, largest first.
-pub fn worst_sfp(report: &EvalReport) -> Vec<(&str, &serde_json::Value)> {
+/// A sample's name and its task's metrics.
+type Scored<'a> = (&'a str, &'a serde_json::Value);
+
+/// A task whose worst samples summary.md shows, with the picture each sample's run wrote.
+struct WorstOf {
+    /// The task, as in a sample's `tasks`.
+    task: &'static str,
+    /// The figure that ranks the samples: a dotted path into the task's metrics.
+    key: &'static str,
+    /// Larger values of the figure are worse (an error, not an accuracy).
+    larger_is_worse: bool,
+    /// The picture (in the sample's `pictures/`) copied to
+    /// `pictures/worst-<task>-<rank>-<name>.png`.
+    picture: &'static str,
+    /// summary.md's section: its heading after "the N samples with the", its text, and the
+    /// columns between the sample's name and its picture, with their cells.
+    heading: &'static str,
+    text: &'static str,
+    columns: &'static [&'static str],
+    cells: fn(&serde_json::Value) -> Vec<String>,
+}
+
+/// The tasks whose worst samples summary.md shows.
+const WORST: [WorstOf; 2] = [
+    WorstOf {
+        task: "sfp",
+        key: "normal.mean_deg",
+        larger_is_worse: true,
+        picture: files::vision::pictures::NORMAL_ERROR,
+        heading: "largest mean angular error",
+        text: "Mean angular error (deg) over object pixels, overall and per reflection type \
+the method chose (a type's error says where it fails: wrong azimuth from a specular/diffuse \
+mix-up, wrong zenith from the index or dilution). Pictures: S0 | estimated normals | true \
+normals | angular error (viridis, 0 to 90 deg).",
+        columns: &[
+            "mean", "median", "diffuse", "specular", "mixed", "none", "index",
+        ],
+        cells: sfp_cells,
+    },
+    WorstOf {
+        task: "transparent",
+        key: "iou",
+        larger_is_worse: false,
+        picture: files::vision::pictures::TRANSPARENT_ERROR,
+        heading: "smallest mask IoU",
+        text: "Low precision is glass marked where there is none (shiny opaque objects, \
+edges, shadows); low recall is glass missed. Pictures: S0 | the mask against the truth: found \
+green, false red, missed blue.",
+        columns: &[
+            "IoU",
+            "precision",
+            "recall",
+            "false positives on opaque objects",
+        ],
+        cells: transparent_cells,
+    },
+];
+
+/// The task's metrics of the [`WORST_SAMPLES`] samples with the worst `of.key`, worst first
+/// (ties by name); samples without the figure are left out.
+fn worst_samples<'a>(report: &'a EvalReport, of: &WorstOf) -> Vec<Scored<'a>> {
     let mut scored: Vec<(&str, &serde_json::Value, f64)> = report
         .samples
         .iter()
         .filter_map(|(name, r)| {
-            let metrics = r.as_ref().ok()?.tasks.get("sfp")?.metrics.as_ref()?;
-            let mean = metrics["normal"]["mean_deg"].as_f64()?;
-            Some((name.as_str(), metrics, mean))
+            let metrics = r.as_ref().ok()?.tasks.get(of.task)?.metrics.as_ref()?;
+            let value = of.key.split('.').fold(metrics, |v, k| &v[k]).as_f64()?;
+            Some((name.as_str(), metrics, value))
         })
         .collect();
-    scored.sort_by(|a, b| b.2.total_cmp(&a.2).then(a.0.cmp(b.0)));
+    scored.sort_by(|a, b| {
+        let order = if of.larger_is_worse {
+            b.2.total_cmp(&a.2)
+        } else {
+            a.2.total_cmp(&b.2)
+        };
+        order.then(a.0.cmp(b.0))
+    });
     scored
         .into_iter()
-        .take(WORST_SFP)
+        .take(WORST_SAMPLES)
         .map(|(n, m, _)| (n, m))
         .collect()
 }
 
-/// Copies each worst sample's error picture to `OUT/pictures/worst-sfp-<rank>-<name>.png`
-/// (after removing those of an earlier report); the relative paths, `None` where a sample
-/// has no picture.
+/// Removes the worst-sample pictures of an earlier report from `OUT/pictures/`.
+fn remove_worst_pictures(out: &Path) -> Result<(), CliError> {
+    let Ok(entries) = std::fs::read_dir(out.join(files::vision::PICTURES)) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        if e.file_name().to_string_lossy().starts_with("worst-") {
+            std::fs::remove_file(e.path()).map_err(|err| CliError::write(e.path(), err))?;
+        }
+    }
+    Ok(())
+}
+
+/// Copies each worst sample's picture to `OUT/pictures/worst-<task>-<rank>-<name>.png`;
+/// the relative paths, `None` where a sample has no picture.
 fn copy_worst_pictures(
     out: &Path,
     dirs: &BTreeMap<String, PathBuf>,
-    worst: &[(&str, &serde_json::Value)],
+    of: &WorstOf,
+    worst: &[Scored<'_>],
 ) -> Result<Vec<Option<String>>, CliError> {
     let folder = out.join(files::vision::PICTURES);
-    if let Ok(entries) = std::fs::read_dir(&folder) {
-        for e in entries.flatten() {
-            if e.file_name().to_string_lossy().starts_with("worst-sfp-") {
-                std::fs::remove_file(e.path()).map_err(|err| CliError::write(e.path(), err))?;
-            }
-        }
-    }
     let mut paths = Vec::new();
     for (rank, (name, _)) in worst.iter().enumerate() {
-        let src = dirs.get(*name).map(|d| {
-            d.join(files::vision::PICTURES)
-                .join(files::vision::pictures::NORMAL_ERROR)
-        });
+        let src = dirs
+            .get(*name)
+            .map(|d| d.join(files::vision::PICTURES).join(of.picture));
         let Some(src) = src.filter(|p| p.is_file()) else {
             paths.push(None);
             continue;
         };
         std::fs::create_dir_all(&folder).map_err(|e| CliError::write(&folder, e))?;
         let rel = format!(
-            "{}/worst-sfp-{}-{name}.png",
+            "{}/worst-{}-{}-{name}.png",
             files::vision::PICTURES,
+            of.task,
             rank + 1
         );
         std::fs::copy(&src, out.join(&rel)).map_err(|e| CliError::write(out.join(&rel), e))?;
@@ -461,44 +536,59 @@ fn copy_worst_pictures(
     Ok(paths)
 }
 
-/// The summary.md section of the worst sfp samples: their figures per reflection type
-/// and their pictures.
-fn worst_markdown(worst: &[(&str, &serde_json::Value)], pictures: &[Option<String>]) -> String {
+/// summary.md's section of a task's worst samples: their figures and pictures.
+fn worst_markdown(of: &WorstOf, worst: &[Scored<'_>], pictures: &[Option<String>]) -> String {
     if worst.is_empty() {
         return String::new();
     }
     let mut s = format!(
-        "\n## sfp: the {} samples with the largest mean angular error\n\n\
-Mean angular error (deg) over object pixels, overall and per reflection type the method chose \
-(a type's error says where it fails: wrong azimuth from a specular/diffuse mix-up, wrong zenith \
-from the index or dilution). Pictures: S0 | estimated normals | true normals | angular error \
-(viridis, 0 to 90 deg).\n\n\
-| sample | mean | median | diffuse | specular | mixed | none | index | picture |\n\
-|---|---|---|---|---|---|---|---|---|\n",
-        worst.len()
+        "\n## {}: the {} samples with the {}\n\n{}\n\n| sample | {} | picture |\n|{}\n",
+        of.task,
+        worst.len(),
+        of.heading,
+        of.text,
+        of.columns.join(" | "),
+        "---|".repeat(of.columns.len() + 2),
     );
-    let num = |v: &serde_json::Value| v.as_f64().map_or("-".into(), |x| format!("{x:.1}"));
     for ((name, m), picture) in worst.iter().zip(pictures) {
-        let n = &m["normal"];
-        let by_type = &n["mean_deg_by_type"];
-        let index = m["ior"]["value"].as_f64().map_or("-".into(), |v| {
-            format!("{v:.3} ({})", m["ior"]["source"].as_str().unwrap_or("?"))
-        });
-        let pic = picture
+        let picture = picture
             .as_ref()
             .map_or("-".into(), |p| format!("![{name}]({p})"));
-        let _ = writeln!(
-            s,
-            "| {name} | {} | {} | {} | {} | {} | {} | {index} | {pic} |",
-            num(&n["mean_deg"]),
-            num(&n["median_deg"]),
-            num(&by_type["diffuse"]),
-            num(&by_type["specular"]),
-            num(&by_type["mixed"]),
-            num(&by_type["none"]),
-        );
+        let _ = writeln!(s, "| {name} | {} | {picture} |", (of.cells)(m).join(" | "));
     }
     s
+}
+
+/// A figure with `decimals` decimals, `-` where absent.
+fn figure(v: &serde_json::Value, decimals: usize) -> String {
+    v.as_f64().map_or("-".into(), |x| format!("{x:.decimals$}"))
+}
+
+/// An sfp sample's mean and median error, its mean per reflection type and its index.
+fn sfp_cells(m: &serde_json::Value) -> Vec<String> {
+    let (n, by_type) = (&m["normal"], &m["normal"]["mean_deg_by_type"]);
+    let index = m["ior"]["value"].as_f64().map_or("-".into(), |v| {
+        format!("{v:.3} ({})", m["ior"]["source"].as_str().unwrap_or("?"))
+    });
+    let mut cells: Vec<String> = [&n["mean_deg"], &n["median_deg"]]
+        .into_iter()
+        .chain(["diffuse", "specular", "mixed", "none"].map(|t| &by_type[t]))
+        .map(|v| figure(v, 1))
+        .collect();
+    cells.push(index);
+    cells
+}
+
+/// A transparency sample's mask figures.
+fn transparent_cells(m: &serde_json::Value) -> Vec<String> {
+    [
+        "iou",
+        "precision",
+        "recall",
+        "false_positive_on_distractors",
+    ]
+    .map(|k| figure(&m[k], 3))
+    .to_vec()
 }
 
 /// A progress bar over `n` samples.

@@ -82,6 +82,31 @@ pub fn overlay_picture(s0: &Gray<f32>, mask: &Gray<u8>) -> Image<u8, 3> {
     from_pixels(s0.size(), data)
 }
 
+/// Found (green), falsely marked (red) and missed (blue) pixels of a mask against the truth.
+pub const MASK_ERROR_COLOURS: [[u8; 3]; 3] = [[40, 200, 60], [230, 40, 40], [40, 90, 230]];
+
+/// S0 as grey beside S0 with the mask `est` compared with `truth` (non-zero = on): found
+/// pixels green, false ones red, missed ones blue ([`MASK_ERROR_COLOURS`]), each half
+/// blended with the grey.
+pub fn mask_error_picture(s0: &Gray<f32>, est: &Gray<u8>, truth: &Gray<u8>) -> Image<u8, 3> {
+    let grey: Vec<f32> = grey_levels(s0).collect();
+    let plain = from_pixels(s0.size(), grey.iter().map(|&g| [g as u8; 3]).collect());
+    let tinted = grey
+        .iter()
+        .zip(est.as_slice().iter().zip(truth.as_slice()))
+        .map(|(&g, (&e, &t))| {
+            let colour = match (e != 0, t != 0) {
+                (true, true) => MASK_ERROR_COLOURS[0],
+                (true, false) => MASK_ERROR_COLOURS[1],
+                (false, true) => MASK_ERROR_COLOURS[2],
+                (false, false) => return [g as u8; 3],
+            };
+            colour.map(|c| (0.5 * g + 0.5 * f32::from(c)) as u8)
+        })
+        .collect();
+    hstack(&[plain, from_pixels(s0.size(), tinted)])
+}
+
 /// Images side by side on one viridis scale from 0 to the first image's 99.5th percentile
 /// (so a dehazed image is seen against its hazy input), then `extra` on its own 0..1 scale.
 pub fn side_by_side(same_scale: &[&Gray<f32>], extra: Option<&Gray<f32>>) -> Image<u8, 3> {
@@ -122,6 +147,20 @@ fn from_pixels((w, h): (usize, usize), px: Vec<[u8; 3]>) -> Image<u8, 3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two panels; the second tints found, false and missed pixels and leaves the rest grey.
+    #[test]
+    fn mask_error_picture_colours_found_false_and_missed_pixels() {
+        let s0 = Gray::from_vec(4, 1, vec![0.0f32, 0.0, 0.0, 0.0]).unwrap();
+        let est = Gray::from_vec(4, 1, vec![1u8, 1, 0, 0]).unwrap();
+        let truth = Gray::from_vec(4, 1, vec![255u8, 0, 255, 0]).unwrap();
+        let p = mask_error_picture(&s0, &est, &truth);
+        assert_eq!(p.size(), (8, 1));
+        let half = |c: [u8; 3]| c.map(|v| (0.5 * f32::from(v)) as u8);
+        let [found, false_on, missed] = MASK_ERROR_COLOURS.map(half);
+        assert_eq!(&p.pixels()[4..], &[found, false_on, missed, [0, 0, 0]]);
+        assert_eq!(&p.pixels()[..4], &[[0, 0, 0]; 4]);
+    }
 
     #[test]
     fn normals_map_to_colours_and_missing_ones_to_black() {

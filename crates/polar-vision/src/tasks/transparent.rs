@@ -9,7 +9,7 @@ use polar_io::{MaterialLabel, Y_CHANNEL};
 use polar_transparency::{Segmenter, TransparencyOptions, detect};
 
 use super::{Context, Failure, Outcome, io, knn_message, picture_path, to_json};
-use crate::pictures::overlay_picture;
+use crate::pictures::{mask_error_picture, overlay_picture};
 use crate::task_options::TaskArgs;
 
 /// Runs the task; leaves the mask for `material`.
@@ -35,6 +35,12 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
         let m = mask_metrics(&map.mask, gt, opaque.as_ref())
             .map_err(|e| Failure::CannotRun(e.to_string()))?;
         outcome.metrics = Some(to_json(&m)?);
+        let picture = mask_error_picture(&ctx.obs.planes.s0, &map.mask, gt);
+        polar_io::write_rgb8_png(
+            picture_path(out, vision::pictures::TRANSPARENT_ERROR),
+            &picture,
+        )
+        .map_err(io)?;
     }
     ctx.transparent = Some(map.mask);
     Ok(outcome)
