@@ -358,12 +358,20 @@ fn dehazing_on_the_ci_haze_family() {
 
 #[test]
 fn material_classification_on_the_ci_material_family() {
-    let (_dir, m) = eval("materials", "sfp,material", "2");
+    let (dir, m) = eval("materials", "sfp,material", "2");
     let acc = family_mean(&m, "materials", "material", "metal_vs_dielectric_accuracy");
     let coverage = family_mean(&m, "materials", "material", "opaque_coverage");
     eprintln!("materials ci: metal vs dielectric {acc:.3} over {coverage:.3} of the objects");
     assert!(acc > MATERIAL_CI_ACCURACY, "accuracy {acc}");
     assert!(coverage > MATERIAL_CI_COVERAGE, "coverage {coverage}");
+    let worst = Worst {
+        task: "material",
+        key: &["metal_vs_dielectric_accuracy"],
+        larger_is_worse: false,
+        heading: "lowest metal vs dielectric accuracy",
+        panels: 3,
+    };
+    worst.is_shown(dir.path(), &m);
 }
 
 #[test]

@@ -107,6 +107,9 @@ pub mod files {
             pub const NORMAL_ERROR: &str = "normal_error.png";
             /// Material labels.
             pub const MATERIAL: &str = "material.png";
+            /// S0, estimated labels and true labels side by side (only where the sample has
+            /// `gt/material.png`).
+            pub const MATERIAL_ERROR: &str = "material_error.png";
             /// Transparency overlay.
             pub const TRANSPARENT: &str = "transparent.png";
             /// S0 beside the transparency mask against the truth: found, false and missed

@@ -430,7 +430,7 @@ struct WorstOf {
 }
 
 /// The tasks whose worst samples summary.md shows.
-const WORST: [WorstOf; 2] = [
+const WORST: [WorstOf; 3] = [
     WorstOf {
         task: "sfp",
         key: "normal.mean_deg",
@@ -445,6 +445,18 @@ normals | angular error (viridis, 0 to 90 deg).",
             "mean", "median", "diffuse", "specular", "mixed", "none", "index",
         ],
         cells: sfp_cells,
+    },
+    WorstOf {
+        task: "material",
+        key: "metal_vs_dielectric_accuracy",
+        larger_is_worse: false,
+        picture: files::vision::pictures::MATERIAL_ERROR,
+        heading: "lowest metal vs dielectric accuracy",
+        text: "Accuracy over the opaque object pixels labelled metal or dielectric, the share \
+of them so labelled, and the classes' IoU. Pictures: S0 | estimated labels | true labels \
+(dielectric orange, metal blue, transparent cyan).",
+        columns: &["accuracy", "labelled share", "dielectric IoU", "metal IoU"],
+        cells: material_cells,
     },
     WorstOf {
         task: "transparent",
@@ -577,6 +589,18 @@ fn sfp_cells(m: &serde_json::Value) -> Vec<String> {
         .collect();
     cells.push(index);
     cells
+}
+
+/// A material sample's accuracy, labelled share and class IoUs.
+fn material_cells(m: &serde_json::Value) -> Vec<String> {
+    [
+        &m["metal_vs_dielectric_accuracy"],
+        &m["opaque_coverage"],
+        &m["class_iou"][1],
+        &m["class_iou"][2],
+    ]
+    .map(|v| figure(v, 3))
+    .to_vec()
 }
 
 /// A transparency sample's mask figures.

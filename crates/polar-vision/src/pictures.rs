@@ -82,6 +82,21 @@ pub fn overlay_picture(s0: &Gray<f32>, mask: &Gray<u8>) -> Image<u8, 3> {
     from_pixels(s0.size(), data)
 }
 
+/// S0 as grey, the estimated labels and the true labels through `palette`, side by side.
+pub fn label_error_picture(
+    s0: &Gray<f32>,
+    est: &Gray<u8>,
+    truth: &Gray<u8>,
+    palette: &[[u8; 3]],
+) -> Image<u8, 3> {
+    let grey = from_pixels(s0.size(), grey_levels(s0).map(|g| [g as u8; 3]).collect());
+    hstack(&[
+        grey,
+        label_picture(est, palette),
+        label_picture(truth, palette),
+    ])
+}
+
 /// Found (green), falsely marked (red) and missed (blue) pixels of a mask against the truth.
 pub const MASK_ERROR_COLOURS: [[u8; 3]; 3] = [[40, 200, 60], [230, 40, 40], [40, 90, 230]];
 
@@ -147,6 +162,17 @@ fn from_pixels((w, h): (usize, usize), px: Vec<[u8; 3]>) -> Image<u8, 3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Three panels: grey S0, then the estimate and the truth through the palette.
+    #[test]
+    fn label_error_picture_shows_estimate_beside_truth() {
+        let s0 = Gray::from_vec(2, 1, vec![0.0f32, 0.0]).unwrap();
+        let est = Gray::from_vec(2, 1, vec![1u8, 2]).unwrap();
+        let truth = Gray::from_vec(2, 1, vec![2u8, 2]).unwrap();
+        let p = label_error_picture(&s0, &est, &truth, &MATERIAL_PALETTE);
+        let [_, d, m, _] = MATERIAL_PALETTE;
+        assert_eq!(p.pixels(), &[[0, 0, 0], [0, 0, 0], d, m, m, m]);
+    }
 
     /// Two panels; the second tints found, false and missed pixels and leaves the rest grey.
     #[test]

@@ -7,7 +7,7 @@ use polar_io::files::vision;
 use polar_material::{Classifier, MaterialOptions, classify};
 
 use super::{Context, Failure, Outcome, io, knn_message, picture_path, to_json};
-use crate::pictures::{MATERIAL_PALETTE, label_picture};
+use crate::pictures::{MATERIAL_PALETTE, label_error_picture, label_picture};
 use crate::task_options::TaskArgs;
 
 /// Runs the task with the normals, object mask and transparency mask of earlier tasks,
@@ -48,6 +48,13 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     if let Some(gt) = &ctx.gt.material {
         let m = material_metrics(&map.labels, gt).map_err(|e| Failure::CannotRun(e.to_string()))?;
         outcome.metrics = Some(to_json(&m)?);
+        let s0 = &ctx.obs.planes.s0;
+        let picture = label_error_picture(s0, &map.labels, gt, &MATERIAL_PALETTE);
+        polar_io::write_rgb8_png(
+            picture_path(out, vision::pictures::MATERIAL_ERROR),
+            &picture,
+        )
+        .map_err(io)?;
     }
     Ok(outcome)
 }
