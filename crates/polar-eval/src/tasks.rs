@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use polar_image::{Gray, NormalImage};
-use polar_imgproc::{AngularErrorStats, ConfusionMatrix, angular_error, psnr, ssim, ssim_map};
+use polar_imgproc::{AngularErrorStats, ConfusionMatrix, angular_error, psnr, ssim_map};
 use serde::{Deserialize, Serialize};
 
 use crate::depth::{DepthFit, depth_fit};
@@ -269,23 +269,21 @@ pub fn dehaze_metrics(
         .copied()
         .filter(|v| v.is_finite())
         .fold(f32::MIN_POSITIVE, f32::max) as f64;
-    let pair = Pair {
-        hazy,
-        dehazed,
-        reference,
-        range,
-    };
-    let t_error = |keep: &[usize]| transmission.map(|(est, gt)| transmission_error(est, gt, keep));
-    let reachable = transmission.and_then(|(_, gt)| pair.reachable(gt));
-    let objects = match labels.map(|l| pixels_where(l.as_slice(), |v| v != 0)) {
-        Some(keep) if !keep.is_empty() => Some(pair.objects(&keep, t_error(&keep))?),
-        _ => None,
-    };
-    let all: Vec<usize> = (0..reference.as_slice().len()).collect();
-    let error = t_error(&all);
+    let pair = Pair { reference, range };
+    let keep = labels
+        .map(|l| pixels_where(l.as_slice(), |v| v != 0))
+        .filter(|k| !k.is_empty());
+    let (hazy_score, hazy_objects) = pair.scores(hazy, keep.as_deref())?;
+    let (dehazed_score, dehazed_objects) = pair.scores(dehazed, keep.as_deref())?;
+    let reachable = transmission.and_then(|(_, gt)| pair.reachable(hazy, dehazed, gt));
+    let objects = keep
+        .as_deref()
+        .zip(hazy_objects.zip(dehazed_objects))
+        .map(|(keep, scores)| object_score(keep, reference.as_slice().len(), scores, transmission));
+    let error = transmission.map(|(est, gt)| transmission_error(est.as_slice(), gt.as_slice()));
     Ok(DehazeMetrics {
-        hazy: pair.whole(hazy)?,
-        dehazed: pair.whole(dehazed)?,
+        hazy: hazy_score,
+        dehazed: dehazed_score,
         transmission_mae: error.map(|e| e.0),
         transmission_correlation: error.and_then(|e| e.1),
         reachable,
@@ -293,21 +291,56 @@ pub fn dehaze_metrics(
     })
 }
 
-/// The hazy input and the dehazed output of one frame, its reference and the data range.
+/// [`ObjectScore`] over the object pixels `keep` of a frame of `len` pixels, from the
+/// input's and the output's scores there and the transmission's error there.
+fn object_score(
+    keep: &[usize],
+    len: usize,
+    (hazy, dehazed): (ImageScore, ImageScore),
+    transmission: Option<(&Gray<f32>, &Gray<f32>)>,
+) -> ObjectScore {
+    let error = transmission.map(|(est, gt)| {
+        let (e, g): (Vec<f32>, Vec<f32>) = keep
+            .iter()
+            .map(|&k| (est.as_slice()[k], gt.as_slice()[k]))
+            .unzip();
+        transmission_error(&e, &g)
+    });
+    ObjectScore {
+        fraction: keep.len() as f64 / len as f64,
+        hazy,
+        dehazed,
+        transmission_mae: error.map(|e| e.0),
+        transmission_correlation: error.and_then(|e| e.1),
+    }
+}
+
+/// A frame's reference and the data range its scores use.
 struct Pair<'a> {
-    hazy: &'a Gray<f32>,
-    dehazed: &'a Gray<f32>,
     reference: &'a Gray<f32>,
     range: f64,
 }
 
 impl Pair<'_> {
-    /// PSNR and SSIM of `img` over the whole frame.
-    fn whole(&self, img: &Gray<f32>) -> Result<ImageScore, EvalError> {
-        Ok(ImageScore {
+    /// PSNR and SSIM of `img` over the whole frame and, where `objects` are given (not
+    /// empty), over them: the mean of the same SSIM map there.
+    fn scores(
+        &self,
+        img: &Gray<f32>,
+        objects: Option<&[usize]>,
+    ) -> Result<(ImageScore, Option<ImageScore>), EvalError> {
+        let (w, h) = self.reference.size();
+        let mut map = Gray::new(w, h);
+        let whole = ImageScore {
             psnr_db: psnr(self.reference, img, self.range)?,
-            ssim: ssim(self.reference, img, self.range)?,
-        })
+            ssim: ssim_map(self.reference, img, self.range, &mut map)?,
+        };
+        let m = map.as_slice();
+        let over = objects.map(|keep| ImageScore {
+            psnr_db: self.psnr_over(img, keep),
+            ssim: keep.iter().map(|&k| f64::from(m[k])).sum::<f64>() / keep.len() as f64,
+        });
+        Ok((whole, over))
     }
 
     /// PSNR (dB) of `img` over the pixels `keep` (not empty).
@@ -317,42 +350,19 @@ impl Pair<'_> {
         10.0 * (self.range * self.range * keep.len() as f64 / sse).log10()
     }
 
-    /// PSNR and the mean of the SSIM map of `img` over the pixels `keep` (not empty).
-    fn over(&self, img: &Gray<f32>, keep: &[usize]) -> Result<ImageScore, EvalError> {
-        let (w, h) = self.reference.size();
-        let mut map = Gray::new(w, h);
-        ssim_map(self.reference, img, self.range, &mut map)?;
-        let m = map.as_slice();
-        Ok(ImageScore {
-            psnr_db: self.psnr_over(img, keep),
-            ssim: keep.iter().map(|&k| f64::from(m[k])).sum::<f64>() / keep.len() as f64,
-        })
-    }
-
     /// [`ReachableScore`] for the true transmission `t_true`; `None` where no pixel is
     /// reachable.
-    fn reachable(&self, t_true: &Gray<f32>) -> Option<ReachableScore> {
+    fn reachable(
+        &self,
+        hazy: &Gray<f32>,
+        dehazed: &Gray<f32>,
+        t_true: &Gray<f32>,
+    ) -> Option<ReachableScore> {
         let keep = pixels_where(t_true.as_slice(), |t| t >= REACHABLE_TRANSMISSION);
         (!keep.is_empty()).then(|| ReachableScore {
             fraction: keep.len() as f64 / t_true.as_slice().len() as f64,
-            hazy_psnr_db: self.psnr_over(self.hazy, &keep),
-            dehazed_psnr_db: self.psnr_over(self.dehazed, &keep),
-        })
-    }
-
-    /// [`ObjectScore`] over the object pixels `keep` (not empty), with the transmission's
-    /// error there.
-    fn objects(
-        &self,
-        keep: &[usize],
-        t_error: Option<(f64, Option<f64>)>,
-    ) -> Result<ObjectScore, EvalError> {
-        Ok(ObjectScore {
-            fraction: keep.len() as f64 / self.reference.as_slice().len() as f64,
-            hazy: self.over(self.hazy, keep)?,
-            dehazed: self.over(self.dehazed, keep)?,
-            transmission_mae: t_error.map(|e| e.0),
-            transmission_correlation: t_error.and_then(|e| e.1),
+            hazy_psnr_db: self.psnr_over(hazy, &keep),
+            dehazed_psnr_db: self.psnr_over(dehazed, &keep),
         })
     }
 }
@@ -362,17 +372,17 @@ fn pixels_where<T: Copy>(v: &[T], keep: impl Fn(T) -> bool) -> Vec<usize> {
     (0..v.len()).filter(|&k| keep(v[k])).collect()
 }
 
-/// Mean absolute error and Pearson correlation of the estimated transmission over `keep`.
-fn transmission_error(est: &Gray<f32>, gt: &Gray<f32>, keep: &[usize]) -> (f64, Option<f64>) {
-    let (e, g) = (est.as_slice(), gt.as_slice());
-    let n = keep.len().max(1) as f64;
-    let mae = keep
+/// Mean absolute error and Pearson correlation of estimated transmissions `est` against
+/// the true ones `gt` (equally long).
+fn transmission_error(est: &[f32], gt: &[f32]) -> (f64, Option<f64>) {
+    let n = est.len().max(1) as f64;
+    let mae = est
         .iter()
-        .map(|&k| f64::from((e[k] - g[k]).abs()))
+        .zip(gt)
+        .map(|(a, b)| f64::from((a - b).abs()))
         .sum::<f64>()
         / n;
-    let (es, gs): (Vec<f32>, Vec<f32>) = keep.iter().map(|&k| (e[k], g[k])).unzip();
-    (mae, pearson(&es, &gs))
+    (mae, pearson(est, gt))
 }
 
 /// Pearson correlation of two equally long series over the pairs where both are finite;

@@ -5,7 +5,7 @@
 //! computed with the cues of [`crate::prepare`]: from the normals and object mask of shape
 //! from polarization where given, as `polar-vision train` gives them at training and `run`
 //! at inference, else from the silhouettes. The features differ with the cues, so a model
-//! holds only for the kind of cues it was trained with.
+//! holds only for the kind of cues it is trained with.
 
 use polar_image::{Gray, NormalImage, par_map};
 use polar_imgproc::{Border, box_filter};

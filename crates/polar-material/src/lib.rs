@@ -129,7 +129,7 @@ pub struct MaterialMap {
 /// `normals`: camera-frame unit normals (e.g. from shape from polarization; `(0,0,0)` =
 /// unknown) give the zenith and azimuth at every pixel; without them the azimuth is taken
 /// from the object silhouettes (a kNN model's features differ with the cues, so it holds
-/// only for the kind it was trained with; `polar-vision train` uses shape from
+/// only for the kind it is trained with; `polar-vision train` uses shape from
 /// polarization's). `foreground`: non-zero on object
 /// pixels; without it [`foreground::estimate`] decides. `transparent`: non-zero on
 /// transparent pixels, which are labelled [`TRANSPARENT`] over the opaque classification.

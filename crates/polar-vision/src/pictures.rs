@@ -47,6 +47,16 @@ fn grey_levels(s0: &Gray<f32>) -> impl Iterator<Item = f32> + '_ {
     })
 }
 
+/// S0 as a grey picture ([`grey_levels`]).
+fn grey_picture(s0: &Gray<f32>) -> Image<u8, 3> {
+    grey_from(s0.size(), grey_levels(s0))
+}
+
+/// A grey picture of grey levels in `[0, 255]`.
+fn grey_from(size: (usize, usize), levels: impl Iterator<Item = f32>) -> Image<u8, 3> {
+    from_pixels(size, levels.map(|g| [g as u8; 3]).collect())
+}
+
 /// Largest angular error (degrees) on the error scale of [`normal_error_picture`].
 pub const ERROR_SCALE_DEG: f32 = 90.0;
 
@@ -58,7 +68,7 @@ pub fn normal_error_picture(
     truth: &NormalImage,
     error: &Gray<f32>,
 ) -> Image<u8, 3> {
-    let grey = from_pixels(s0.size(), grey_levels(s0).map(|g| [g as u8; 3]).collect());
+    let grey = grey_picture(s0);
     hstack(&[
         grey,
         normal_picture(est),
@@ -89,7 +99,7 @@ pub fn label_error_picture(
     truth: &Gray<u8>,
     palette: &[[u8; 3]],
 ) -> Image<u8, 3> {
-    let grey = from_pixels(s0.size(), grey_levels(s0).map(|g| [g as u8; 3]).collect());
+    let grey = grey_picture(s0);
     hstack(&[
         grey,
         label_picture(est, palette),
@@ -105,7 +115,6 @@ pub const MASK_ERROR_COLOURS: [[u8; 3]; 3] = [[40, 200, 60], [230, 40, 40], [40,
 /// blended with the grey.
 pub fn mask_error_picture(s0: &Gray<f32>, est: &Gray<u8>, truth: &Gray<u8>) -> Image<u8, 3> {
     let grey: Vec<f32> = grey_levels(s0).collect();
-    let plain = from_pixels(s0.size(), grey.iter().map(|&g| [g as u8; 3]).collect());
     let tinted = grey
         .iter()
         .zip(est.as_slice().iter().zip(truth.as_slice()))
@@ -119,7 +128,10 @@ pub fn mask_error_picture(s0: &Gray<f32>, est: &Gray<u8>, truth: &Gray<u8>) -> I
             colour.map(|c| (0.5 * g + 0.5 * f32::from(c)) as u8)
         })
         .collect();
-    hstack(&[plain, from_pixels(s0.size(), tinted)])
+    hstack(&[
+        grey_from(s0.size(), grey.into_iter()),
+        from_pixels(s0.size(), tinted),
+    ])
 }
 
 /// Images side by side on one viridis scale from 0 to the first image's 99.5th percentile
