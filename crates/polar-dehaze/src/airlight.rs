@@ -50,6 +50,7 @@
 
 use std::collections::HashSet;
 
+use nalgebra::{DMatrix, DVector};
 use polar_image::{Gray, quantile};
 use rayon::prelude::*;
 
@@ -310,7 +311,7 @@ pub fn fit_angle_field(blocks: &Blocks) -> Option<AngleField> {
 }
 
 /// Weighted least squares of both components on the monomials, with a tiny ridge so
-/// that a degenerate layout (one row of blocks) still solves.
+/// that a degenerate layout (one row of blocks) still solves (LU, `None` if singular).
 fn weighted_fit(
     degree: usize,
     phi: &[Vec<f64>],
@@ -318,62 +319,30 @@ fn weighted_fit(
     weights: &[f64],
 ) -> Option<AngleField> {
     let m = (degree + 1) * (degree + 2) / 2;
-    let mut ata = vec![vec![0.0; m]; m];
-    let (mut bc, mut bs) = (vec![0.0; m], vec![0.0; m]);
+    let mut ata = DMatrix::<f64>::zeros(m, m);
+    let mut atb = DMatrix::<f64>::zeros(m, 2);
     let mut wsum = 0.0;
     for ((p, u), &w) in phi.iter().zip(unit).zip(weights) {
         if w <= 0.0 {
             continue;
         }
         wsum += w;
-        for a in 0..m {
-            for b in 0..m {
-                ata[a][b] += w * p[a] * p[b];
-            }
-            bc[a] += w * p[a] * u.0;
-            bs[a] += w * p[a] * u.1;
-        }
+        let row = DVector::from_column_slice(&p[..m]);
+        ata.ger(w, &row, &row, 1.0);
+        atb.column_mut(0).axpy(w * u.0, &row, 1.0);
+        atb.column_mut(1).axpy(w * u.1, &row, 1.0);
     }
     if wsum <= 0.0 {
         return None;
     }
-    for (a, row) in ata.iter_mut().enumerate() {
-        row[a] += 1e-9 * wsum;
-    }
-    Some(AngleField {
+    let x = (ata + DMatrix::identity(m, m) * (1e-9 * wsum))
+        .lu()
+        .solve(&atb)?;
+    x.iter().all(|v| v.is_finite()).then(|| AngleField {
         degree,
-        cos: solve(ata.clone(), bc)?,
-        sin: solve(ata, bs)?,
+        cos: x.column(0).iter().copied().collect(),
+        sin: x.column(1).iter().copied().collect(),
     })
-}
-
-/// Solves `a x = b` by Gaussian elimination with partial pivoting; `None` if singular.
-fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
-    let m = b.len();
-    for col in 0..m {
-        let piv = (col..m).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[piv][col].abs() < 1e-300 || !a[piv][col].is_finite() {
-            return None;
-        }
-        a.swap(col, piv);
-        b.swap(col, piv);
-        let (top, rest) = a.split_at_mut(col + 1);
-        let pivot_row = &top[col];
-        for (r, row) in rest.iter_mut().enumerate() {
-            let f = row[col] / pivot_row[col];
-            row[col..]
-                .iter_mut()
-                .zip(&pivot_row[col..])
-                .for_each(|(v, p)| *v -= f * p);
-            b[col + 1 + r] -= f * b[col];
-        }
-    }
-    let mut x = vec![0.0; m];
-    for r in (0..m).rev() {
-        let s: f64 = (r + 1..m).map(|c| a[r][c] * x[c]).sum();
-        x[r] = (b[r] - s) / a[r][r];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// Estimates `alpha(x, y)`, `p` and `A_inf` (see the module doc). `None` when no usable
