@@ -180,6 +180,13 @@ def components(wr, rng):
     for name, src in [("mask", mask), ("outlines", outlines)]:
         hull = convex_hull_object(src > 0, connectivity=2).astype(np.uint8)
         wr.case(f"convex_hull_{name}", "convex_hull_objects", {}, {"src": (name, src)}, {"hull": hull})
+    # Euclidean distance to the nearest zero pixel, beyond the frame not background (as
+    # OpenCV has it) or background (a zero frame added, then cropped).
+    inside = cv2.distanceTransform(mask, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    framed = cv2.distanceTransform(np.pad(mask, 1), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+    for outside, dist in [("not_background", inside), ("background", framed)]:
+        wr.case(f"distance_{outside}", "distance_to_background", {"outside": outside},
+                {"src": ("mask", mask)}, {"dist": dist.astype(np.float32)})
 
 
 def metrics(wr, rng, img, degraded):

@@ -20,7 +20,9 @@
 //! | [`label`], [`component_stats`] | `skimage.measure.label`, `cv2.connectedComponentsWithStats` | - |
 //! | [`psnr`], [`ssim`], [`ssim_map`] | `skimage.metrics.peak_signal_noise_ratio`, `structural_similarity` | SSIM: `BORDER_REFLECT` (scipy `reflect`) |
 //! | [`angular_error`], [`iou`], [`ConfusionMatrix`] | numpy formulas in the golden script | - |
+//! | [`distance_to_background`] | `cv2.distanceTransform(src, DIST_L2, DIST_MASK_PRECISE)` | chosen ([`Outside`]) |
 
+mod distance;
 mod filter;
 mod guided;
 mod label;
@@ -30,6 +32,7 @@ mod metrics;
 mod morph;
 mod threshold;
 
+pub use distance::{Outside, distance_to_background};
 pub use filter::{
     box_filter, gaussian_blur, gaussian_kernel, scharr, sep_filter, sobel, sobel_kernels,
 };

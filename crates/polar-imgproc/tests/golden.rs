@@ -13,6 +13,7 @@
 //! - SSIM map `1e-4` and mean SSIM `1e-6` relative: scipy filters in `f64` and rounds
 //!   between the two passes, we accumulate in `f32`; `var = E[x^2] - E[x]^2` cancels,
 //!   which amplifies that rounding in flat regions.
+//! - distance transform `1e-5` pixels (OpenCV's exact transform in `f32`);
 //! - PSNR `1e-9` relative (`f64` sums in another order); angular error statistics
 //!   `1e-6` degrees (we use `atan2`, numpy `arccos`).
 
@@ -328,6 +329,34 @@ fn convex_hulls_equal_skimage_convex_hull_object() {
             .count();
         assert_eq!(differ, 0, "{}: {differ} pixels differ", case["name"]);
         assert!(got.iter().filter(|&&b| b).count() > m.iter().filter(|&&b| b).count());
+    }
+}
+
+/// `cv2.distanceTransform(DIST_L2, DIST_MASK_PRECISE)` is the same exact transform in
+/// `f32`: `1e-5` pixels.
+#[test]
+fn distances_equal_cv2_distance_transform() {
+    let g = Golden::load();
+    let cases = g.cases("distance_to_background");
+    assert_eq!(cases.len(), 2);
+    for case in cases {
+        let src = g.gray_u8(&g.input(case, "src"));
+        let (w, h) = (src.width(), src.height());
+        let m: Vec<bool> = src.as_slice().iter().map(|&v| v != 0).collect();
+        let outside = match case["params"]["outside"].as_str() {
+            Some("background") => Outside::Background,
+            Some("not_background") => Outside::NotBackground,
+            other => panic!("outside {other:?}"),
+        };
+        let got = distance_to_background(&m, w, h, outside);
+        let (want, _) = g.f32s(&g.output(case, "dist"));
+        let err = got
+            .iter()
+            .zip(&want)
+            .map(|(a, b)| (a - f64::from(*b)).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-5, "{}: max |diff| {err}", case["name"]);
+        assert!(want.iter().any(|&d| d > 3.0), "a mask with an inside");
     }
 }
 

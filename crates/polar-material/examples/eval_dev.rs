@@ -314,7 +314,7 @@ fn stats(c: &Case) {
         .map(|&v| v == 1 || v == 2)
         .collect();
     let regions = polar_material::Regions::new(&fgm, w, h).unwrap();
-    let dist = polar_material::cues::chamfer_distance(&fgm, w, h);
+    let dist = polar_material::cues::silhouette_distance(&fgm, w, h);
     let sil = polar_material::cues::from_silhouette(&f, &fgm, &regions, &dist).unwrap();
     for l in [1u8, 2] {
         let m = Gray::from_vec(

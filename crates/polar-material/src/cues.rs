@@ -10,7 +10,7 @@
 //! of the blurred mask's gradient.
 
 use polar_image::{Gray, NormalImage, par_map};
-use polar_imgproc::gaussian_blur;
+use polar_imgproc::{Outside, gaussian_blur};
 use polar_sensor::Observation;
 
 use crate::features::Features;
@@ -79,7 +79,7 @@ impl Cues {
     /// other way (a face turned to the camera is read as turned away), which only makes
     /// the Fresnel cue more cautious; it also lets the phase cue count the pixels it
     /// puts near the occluding contour.
-    /// `distance`: [`chamfer_distance`] of the object mask the `regions` label.
+    /// `distance`: [`silhouette_distance`] of the object mask the `regions` label.
     pub fn with_prior_floor(mut self, regions: &Regions, distance: &[f32]) -> Self {
         let prior = sphere_prior_zenith(regions, distance);
         for (z, &p) in self.zenith.iter_mut().zip(&prior) {
@@ -98,7 +98,7 @@ pub const BAND: usize = 3;
 /// inside the boundary; zenith from a sphere prior: a pixel at distance `d` from the
 /// silhouette of a region whose largest such distance is `R` sees `sin θ = 1 − d/R`
 /// (exact for a sphere, a rough guess for other convex shapes). `distance`:
-/// [`chamfer_distance`] of `fg`.
+/// [`silhouette_distance`] of `fg`.
 pub fn from_silhouette(
     f: &Features,
     fg: &[bool],
@@ -160,43 +160,11 @@ fn sphere_prior_zenith(regions: &Regions, d: &[f32]) -> Vec<f32> {
     })
 }
 
-/// Two-pass 3-4 chamfer distance (Borgefors 1986) in pixels from each `fg` pixel to the
-/// nearest non-`fg` pixel, the image outside counting as non-`fg`.
-pub fn chamfer_distance(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
-    let big = 1e9f32;
-    let mut d: Vec<f32> = fg.iter().map(|&b| if b { big } else { 0.0 }).collect();
-    let at = |d: &[f32], x: isize, y: isize| -> f32 {
-        if x < 0 || y < 0 || x >= w as isize || y >= h as isize {
-            0.0
-        } else {
-            d[y as usize * w + x as usize]
-        }
-    };
-    for y in 0..h as isize {
-        for x in 0..w as isize {
-            let k = y as usize * w + x as usize;
-            if d[k] == 0.0 {
-                continue;
-            }
-            let v = (at(&d, x - 1, y) + 3.0)
-                .min(at(&d, x, y - 1) + 3.0)
-                .min(at(&d, x - 1, y - 1) + 4.0)
-                .min(at(&d, x + 1, y - 1) + 4.0);
-            d[k] = d[k].min(v);
-        }
-    }
-    for y in (0..h as isize).rev() {
-        for x in (0..w as isize).rev() {
-            let k = y as usize * w + x as usize;
-            if d[k] == 0.0 {
-                continue;
-            }
-            let v = (at(&d, x + 1, y) + 3.0)
-                .min(at(&d, x, y + 1) + 3.0)
-                .min(at(&d, x + 1, y + 1) + 4.0)
-                .min(at(&d, x - 1, y + 1) + 4.0);
-            d[k] = d[k].min(v);
-        }
-    }
-    d.iter().map(|v| v / 3.0).collect()
+/// Euclidean distance in pixels from each `fg` pixel to the nearest non-`fg` pixel, the
+/// image outside counting as non-`fg` ([`polar_imgproc::distance_to_background`]).
+pub fn silhouette_distance(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
+    polar_imgproc::distance_to_background(fg, w, h, Outside::Background)
+        .iter()
+        .map(|&d| d as f32)
+        .collect()
 }

@@ -191,7 +191,7 @@ pub fn prepare(
         None => foreground::estimate(&features)?,
     };
     let regions = Regions::new(&fg, size.0, size.1)?;
-    let distance = cues::chamfer_distance(&fg, size.0, size.1);
+    let distance = cues::silhouette_distance(&fg, size.0, size.1);
     let cues = match normals {
         Some(n) => cues::from_normals(obs, &features, n)?.with_prior_floor(&regions, &distance),
         None => cues::from_silhouette(&features, &fg, &regions, &distance)?,

@@ -27,7 +27,8 @@ use polar_image::quantile;
 
 use crate::ShapeError;
 use crate::cues::{Cues, DOLP_NOISE_AT_SCALE, HIGHLIGHT};
-use crate::local::{distance_to_background, outward_directions};
+use crate::local::outward_directions;
+use polar_imgproc::{Outside, distance_to_background};
 use polar_optics::reflection_dolp::diffuse_dolp;
 
 /// Width (pixels) of the band inside the silhouette whose DoLP profile is fitted.
@@ -113,7 +114,7 @@ struct Bin {
 /// Diffuse-like contour pixels binned by distance `1..=BAND` (module doc).
 fn contour_profile(cues: &Cues, fg: &[bool]) -> Result<Vec<Bin>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
-    let dist = distance_to_background(fg, w, h);
+    let dist = distance_to_background(fg, w, h, Outside::NotBackground);
     let mut bins: Vec<Bin> = (0..BAND).map(|_| Bin::default()).collect();
     if dist.iter().all(|d| !d.is_finite()) {
         return Ok(bins);

@@ -41,7 +41,10 @@
 
 use nalgebra::Vector3;
 use polar_image::Gray;
-use polar_imgproc::{Border, Connectivity, gaussian_blur, gaussian_kernel, label, sep_filter};
+use polar_imgproc::{
+    Border, Connectivity, Outside, distance_to_background, gaussian_blur, gaussian_kernel, label,
+    sep_filter,
+};
 use rayon::prelude::*;
 
 use crate::cues::{Cues, image_direction, image_direction_angle};
@@ -296,7 +299,7 @@ fn smooth_field(
 pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let n = w * h;
-    let dist = distance_to_background(fg, w, h);
+    let dist = distance_to_background(fg, w, h, Outside::NotBackground);
     if dist.iter().all(|d| !d.is_finite()) {
         // No contour: the prior faces the camera and carries no weight.
         let normal = (0..n).map(|k| -cues.frame(k).d).collect();
@@ -311,7 +314,7 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
     let seeds = verified_contour(cues, fg, &dist, &outward)?;
     let to_verified = if seeds.iter().any(|&s| s) {
         let not_seed: Vec<bool> = seeds.iter().map(|&s| !s).collect();
-        distance_to_background(&not_seed, w, h)
+        distance_to_background(&not_seed, w, h, Outside::NotBackground)
     } else {
         dist.clone()
     };
@@ -468,131 +471,4 @@ fn component_max(fg: &[bool], dist: &[f64], w: usize, h: usize) -> Result<Vec<f6
         }
     }
     Ok(l.iter().map(|&c| max[c as usize]).collect())
-}
-
-/// Euclidean distance (pixels) from each pixel to the nearest non-foreground pixel
-/// (Felzenszwalb & Huttenlocher 2012, two passes of the 1-D squared transform); 0 on the
-/// background, infinite everywhere when there is no background pixel. Pixels outside
-/// the image are not background: a border cut is not an occluding contour.
-pub fn distance_to_background(fg: &[bool], w: usize, h: usize) -> Vec<f64> {
-    if fg.iter().all(|&f| f) {
-        return vec![f64::INFINITY; w * h];
-    }
-    let inf_or_zero = |f: bool| if f { f64::INFINITY } else { 0.0 };
-    // Columns into a column-major buffer, then rows back into row-major order.
-    let mut cols = vec![0.0f64; w * h];
-    cols.par_chunks_mut(h)
-        .enumerate()
-        .for_each_init(Edt::default, |edt, (x, out)| {
-            edt.run((0..h).map(|y| inf_or_zero(fg[y * w + x])), out);
-        });
-    let mut d = vec![0.0f64; w * h];
-    d.par_chunks_mut(w)
-        .enumerate()
-        .for_each_init(Edt::default, |edt, (y, out)| {
-            edt.run((0..w).map(|x| cols[x * h + y]), out);
-            out.iter_mut().for_each(|v| *v = v.sqrt());
-        });
-    d
-}
-
-/// Scratch of [`edt_1d`], reused across the lines of one thread.
-#[derive(Default)]
-struct Edt {
-    f: Vec<f64>,
-    v: Vec<usize>,
-    z: Vec<f64>,
-}
-
-impl Edt {
-    /// The squared distance transform of the line `f` into `out`.
-    fn run(&mut self, f: impl Iterator<Item = f64>, out: &mut [f64]) {
-        self.f.clear();
-        self.f.extend(f);
-        edt_1d(&self.f, out, &mut self.v, &mut self.z);
-    }
-}
-
-/// 1-D squared distance transform of `f` (lower envelope of parabolas) into `out`.
-fn edt_1d(f: &[f64], out: &mut [f64], v: &mut Vec<usize>, z: &mut Vec<f64>) {
-    let n = f.len();
-    out.fill(f64::INFINITY);
-    v.clear();
-    v.resize(n, 0);
-    z.clear();
-    z.resize(n + 1, 0.0);
-    let mut k = 0usize;
-    let mut started = false;
-    for q in 0..n {
-        if f[q].is_infinite() {
-            continue;
-        }
-        if !started {
-            v[0] = q;
-            z[0] = f64::NEG_INFINITY;
-            z[1] = f64::INFINITY;
-            started = true;
-            continue;
-        }
-        loop {
-            let p = v[k];
-            let s =
-                ((f[q] + (q * q) as f64) - (f[p] + (p * p) as f64)) / (2.0 * (q as f64 - p as f64));
-            if s <= z[k] && k > 0 {
-                k -= 1;
-                continue;
-            }
-            if s <= z[k] {
-                // k == 0 and the new parabola dominates everywhere.
-                v[0] = q;
-                z[0] = f64::NEG_INFINITY;
-                z[1] = f64::INFINITY;
-                break;
-            }
-            k += 1;
-            v[k] = q;
-            z[k] = s;
-            z[k + 1] = f64::INFINITY;
-            break;
-        }
-    }
-    if !started {
-        return;
-    }
-    k = 0;
-    for (q, o) in out.iter_mut().enumerate() {
-        while z[k + 1] < q as f64 {
-            k += 1;
-        }
-        let p = v[k];
-        let dq = q as f64 - p as f64;
-        *o = dq * dq + f[p];
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn distance_transform_matches_brute_force() {
-        let (w, h) = (9, 7);
-        let fg: Vec<bool> = (0..w * h)
-            .map(|k| !matches!((k % w, k / w), (0, 0) | (6, 4) | (3, 6)))
-            .collect();
-        let d = distance_to_background(&fg, w, h);
-        for (k, dk) in d.iter().enumerate() {
-            let (x, y) = ((k % w) as f64, (k / w) as f64);
-            let brute = [(0.0, 0.0), (6.0, 4.0), (3.0, 6.0)]
-                .iter()
-                .map(|(a, b)| (x - a).hypot(y - b))
-                .fold(f64::INFINITY, f64::min);
-            assert!((dk - brute).abs() < 1e-12, "{k}: {dk} {brute}");
-        }
-        assert!(
-            distance_to_background(&[true; 4], 2, 2)
-                .iter()
-                .all(|v| v.is_infinite())
-        );
-    }
 }

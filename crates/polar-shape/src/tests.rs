@@ -694,8 +694,12 @@ fn textured_floor_and_cast_shadow_are_not_coherent_foreground() {
     let in_shadow = (0..fg.len()).filter(|&k| fg[k] && shadow[k]).count();
     assert_eq!(in_shadow, 0, "cast-shadow pixels taken as foreground");
     // Floor pixels more than 3 pixels from the sphere: none may be foreground.
-    let near =
-        crate::local::distance_to_background(&truth.iter().map(|t| !t).collect::<Vec<_>>(), 96, 96);
+    let near = polar_imgproc::distance_to_background(
+        &truth.iter().map(|t| !t).collect::<Vec<_>>(),
+        96,
+        96,
+        polar_imgproc::Outside::NotBackground,
+    );
     let far_floor = (0..fg.len()).filter(|&k| fg[k] && near[k] > 3.0).count();
     assert_eq!(far_floor, 0, "floor texture taken as foreground");
 }
@@ -1024,7 +1028,12 @@ fn merged_cast_shadow_does_not_steer_the_prior() {
     // Shadow pixels more than 6 pixels (three window sigmas along the boundary) from
     // the sphere: their nearest boundary is the shadow's own.
     let off_sphere: Vec<bool> = truth.iter().map(|t| !t).collect();
-    let from_sphere = crate::local::distance_to_background(&off_sphere, 96, 96);
+    let from_sphere = polar_imgproc::distance_to_background(
+        &off_sphere,
+        96,
+        96,
+        polar_imgproc::Outside::NotBackground,
+    );
     let steered: Vec<usize> = (0..fg.len())
         .filter(|&k| shadow(k) && from_sphere[k] > 6.0 && prior.weight[k] > 0.0)
         .collect();
