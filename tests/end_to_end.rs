@@ -25,8 +25,9 @@ const MATERIAL_CI_ACCURACY: f64 = 0.70;
 /// measured 0.841; below the bound sfp's object mask has lost about a whole object of the
 /// four small samples, which the accuracy alone would not show.
 const MATERIAL_CI_COVERAGE: f64 = 0.75;
-/// Transparent mask IoU on the ci glass family: measured 0.328 (target 0.85 clean).
-const TRANSPARENT_CI_IOU: f64 = 0.3;
+/// Transparent mask IoU on the ci glass family: measured 0.361 (target 0.85 clean); the
+/// bound fails if the depolarized-rim trim is lost (0.328 without).
+const TRANSPARENT_CI_IOU: f64 = 0.34;
 
 use common::{arg, family_mean, json, standard_ci, vision};
 use polar_io::files::{self, vision};

@@ -23,6 +23,9 @@ pub const HALF_DOLP: f32 = 0.05;
 /// The cue planes of one observation.
 #[derive(Clone, Debug)]
 pub struct CueMaps {
+    /// Per-pixel DoLP of the median-filtered `(S1/S0, S2/S0)`, before the window: edges
+    /// stay where they are.
+    pub pixel_dolp: Vec<f32>,
     /// Windowed DoLP in `[0, 1]` (0 where no valid pixel is in the window).
     pub dolp: Vec<f32>,
     /// Coherence of the polarization over the window, in `[0, 1]`.
@@ -114,6 +117,7 @@ pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
         }
     });
     Ok(CueMaps {
+        pixel_dolp: d,
         dolp,
         coherence,
         q: qw,
@@ -121,13 +125,12 @@ pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
     })
 }
 
-/// The per-pixel transparency score in `[0, 1)` (see the module docs).
-pub fn score(obs: &Observation) -> Result<Gray<f32>, TransparencyError> {
-    let (w, h) = obs.size();
-    let c = cue_maps(obs)?;
+/// The per-pixel transparency score in `[0, 1)` of the cue maps of a `w x h` frame (see
+/// the module docs).
+pub fn score(c: &CueMaps, w: usize, h: usize) -> Gray<f32> {
     let s = par_map(w * h, |k| {
         let e = c.dolp[k] * c.coherence[k];
         e / (e + HALF_DOLP)
     });
-    Ok(Gray::from_vec(w, h, s).expect("size of the observation"))
+    Gray::from_vec(w, h, s).expect("size of the cue maps")
 }

@@ -84,14 +84,15 @@ struct FrameFeatures {
 }
 
 impl FrameFeatures {
-    fn new(obs: &Observation) -> Result<Self, TransparencyError> {
+    /// The features of `obs` from its cue maps `c`.
+    fn new(obs: &Observation, c: CueMaps) -> Result<Self, TransparencyError> {
         let (w, h) = obs.size();
         if w == 0 || h == 0 {
             return Err(TransparencyError::Empty(w, h));
         }
-        let c = cue_maps(obs)?;
         let n = w * h;
         let CueMaps {
+            pixel_dolp: _,
             dolp,
             coherence,
             q,
@@ -163,7 +164,7 @@ fn gradient(v: &[f32], w: usize, h: usize) -> Result<Vec<f32>, TransparencyError
 
 /// Per-pixel feature vectors ([`FEATURES`]), row-major, one per pixel.
 pub fn pixel_features(obs: &Observation) -> Result<Vec<[f32; DIMS]>, TransparencyError> {
-    let x = FrameFeatures::new(obs)?;
+    let x = FrameFeatures::new(obs, cue_maps(obs)?)?;
     Ok(par_map(x.valid.len(), |k| x.at(k)))
 }
 
@@ -189,10 +190,15 @@ fn bracket(x: usize, nodes: &[usize], stride: usize) -> (usize, usize, f32) {
 
 /// Probability of transparent per pixel: the fraction of transparent points among the `k`
 /// nearest training points, on a grid of at most about [`MAX_QUERIES`] nodes, interpolated
-/// bilinearly in between (every pixel is a node on frames up to that size).
-pub fn probability(clf: &KnnClassifier, obs: &Observation) -> Result<Gray<f32>, TransparencyError> {
+/// bilinearly in between (every pixel is a node on frames up to that size). `cues` are
+/// the cue maps of `obs`.
+pub fn probability(
+    clf: &KnnClassifier,
+    obs: &Observation,
+    cues: CueMaps,
+) -> Result<Gray<f32>, TransparencyError> {
     let (w, h) = obs.size();
-    let x = FrameFeatures::new(obs)?;
+    let x = FrameFeatures::new(obs, cues)?;
     let stride = (((w * h) as f64 / MAX_QUERIES as f64).sqrt().ceil() as usize).max(1);
     let (nx, ny) = (nodes(w, stride), nodes(h, stride));
     let grid: Vec<f32> = (0..nx.len() * ny.len())
@@ -230,7 +236,7 @@ pub fn add_training_pixels(
             got: labels.size(),
         });
     }
-    let x = FrameFeatures::new(obs)?;
+    let x = FrameFeatures::new(obs, cue_maps(obs)?)?;
     for (k, &l) in labels.as_slice().iter().enumerate() {
         if x.valid[k] {
             points.extend_from_slice(&x.at(k));

@@ -10,8 +10,9 @@
 //! DoLP: sensor noise and demosaicing artefacts at texture edges have random AoLP and
 //! average out); it then thresholds the score
 //! (Otsu, or a given threshold), closes and opens the mask, fills holes (background
-//! components not touching the border), drops specks and replaces each component by its
-//! convex hull, all with polar-imgproc. The hull is there because glass is polarized
+//! components not touching the border), drops specks, replaces each component by its
+//! convex hull and trims the depolarized rim that the window added around it
+//! ([`WINDOW`](cues::WINDOW)), all with polar-imgproc. The hull is there because glass is polarized
 //! mostly along its rims and edges (reflection and transmission both grow toward
 //! grazing) and little where it faces the camera, so the seeds are open arcs around
 //! the object; glass objects (balls, slabs, cups, bottles) are mostly convex.
@@ -156,9 +157,11 @@ pub fn detect(
     {
         return Err(TransparencyError::Threshold(t));
     }
+    let maps = cues::cue_maps(obs)?;
+    let pixel_dolp = maps.pixel_dolp.clone();
     let (score, t) = match segmenter {
         Segmenter::Cues => {
-            let score = cues::score(obs)?;
+            let score = cues::score(&maps, w, h);
             let t = match opts.threshold {
                 Some(t) => t,
                 None => threshold_otsu(&score)?.max(MIN_THRESHOLD),
@@ -166,7 +169,7 @@ pub fn detect(
             (score, t)
         }
         Segmenter::Knn(clf) => (
-            knn::probability(clf, obs)?,
+            knn::probability(clf, obs, maps)?,
             opts.threshold.unwrap_or(KNN_THRESHOLD),
         ),
     };
@@ -175,6 +178,7 @@ pub fn detect(
     let m = polar_imgproc::mask::remove_small(&m, w, h, MIN_WINDOWS * cues::WINDOW.pow(2))?;
     let m = polar_imgproc::mask::convex_hull_objects(&m, w, h)?;
     let m = without_dark_regions(obs, m)?;
+    let m = without_depolarized_rim(&m, &pixel_dolp, w, h)?;
     let mask = Gray::from_vec(w, h, m.iter().map(|&b| if b { ON } else { 0 }).collect())
         .expect("size of the observation");
     Ok(TransparencyMap { mask, score })
@@ -213,6 +217,28 @@ fn without_dark_regions(
         .collect();
     Ok((0..w * h)
         .map(|k| mask[k] && keep[id[k] as usize])
+        .collect())
+}
+
+/// `mask` without the pixels within [`cues::WINDOW`]` / 2` of its outline whose own
+/// (median-filtered) DoLP is below [`cues::HALF_DOLP`]: the window carries a rim's strong
+/// polarization that far onto the depolarizing background around it, and the hull
+/// encloses it. Glass keeps its rims: reflection and transmission polarize most toward
+/// grazing.
+fn without_depolarized_rim(
+    mask: &[bool],
+    pixel_dolp: &[f32],
+    w: usize,
+    h: usize,
+) -> Result<Vec<bool>, TransparencyError> {
+    let side = cues::WINDOW / 2 * 2 + 1;
+    let src = Gray::from_vec(w, h, mask.iter().map(|&b| f32::from(u8::from(b))).collect())
+        .expect("size of the observation");
+    let mut inner = Gray::new(w, h);
+    polar_imgproc::min_filter(&src, &mut inner, side, side)?;
+    let inner = inner.as_slice();
+    Ok((0..w * h)
+        .map(|k| mask[k] && (inner[k] > 0.5 || pixel_dolp[k] >= cues::HALF_DOLP))
         .collect())
 }
 
