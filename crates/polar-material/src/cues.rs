@@ -141,7 +141,7 @@ pub fn from_silhouette(
     })
 }
 
-/// Zenith of the sphere prior (NaN outside the mask), from each pixel's chamfer distance
+/// Zenith of the sphere prior (NaN outside the mask), from each pixel's distance
 /// to the nearest pixel outside the mask (or the image) and its maximum per region.
 fn sphere_prior_zenith(regions: &Regions, d: &[f32]) -> Vec<f32> {
     let lab = &regions.labels;

@@ -64,8 +64,9 @@ pub struct Prepared {
     pub fg: Vec<bool>,
     /// The 8-connected regions of `fg`.
     pub regions: Regions,
-    /// Chamfer distance of each pixel to the nearest pixel outside `fg` (0 outside it):
-    /// the sphere prior's and the neck splitting's one distance map.
+    /// Euclidean distance of each pixel to the nearest pixel outside `fg` or the image (0
+    /// outside `fg`, [`cues::silhouette_distance`]): the sphere prior's and the neck
+    /// splitting's one distance map.
     pub distance: Vec<f32>,
     /// Phase and zenith cues, from the normals where given, else from the silhouettes.
     pub cues: cues::Cues,
