@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, as CI runs it (see README "Set-up"):
 #   1. the pinned Python references (tools/.venv) and Debian's libllvm19 for Mitsuba,
-#   2. formatting and lints,
+#   2. formatting, lints and the API docs,
 #   3. every Rust test in release mode (numeric-heavy),
 #   4. the cross-checks that regenerate reference outputs with the pinned Python
 #      packages and compare them with ours (drift in either side fails the run).
@@ -18,6 +18,9 @@ cargo fmt --all -- --check
 
 step "cargo clippy -D warnings"
 cargo clippy --workspace --all-targets --locked -- -D warnings
+
+step "cargo doc -D warnings (no broken or private links in the API docs)"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked --quiet
 
 step "cargo test --release"
 cargo test --workspace --release --locked

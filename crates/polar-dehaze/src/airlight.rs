@@ -406,7 +406,7 @@ const EXPECTILE_PASSES: usize = 10;
 /// Candidates whose `P` is within this fraction below the envelope are at infinity.
 pub const INFINITY_TOLERANCE: f64 = 0.1;
 /// Blocks at infinity whose airlight is below this share of the brightest sky's are not
-/// sky ([`bright_inner`]); a sky brighter towards the sun keeps its dimmer side down to
+/// sky (`bright_inner`); a sky brighter towards the sun keeps its dimmer side down to
 /// this share.
 pub const SKY_AIRLIGHT_SHARE: f64 = 0.7;
 

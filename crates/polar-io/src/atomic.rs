@@ -59,7 +59,7 @@ pub(crate) fn write_file_atomic(
     result
 }
 
-/// Writes `bytes` to `path` atomically and durably (see [`write_file_atomic`]).
+/// Writes `bytes` to `path` atomically and durably (see `write_file_atomic`).
 pub fn write_atomic(path: impl AsRef<Path>, bytes: &[u8]) -> Result<()> {
     let path = path.as_ref();
     write_file_atomic(path, Durability::Synced, |w| {

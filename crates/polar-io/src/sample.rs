@@ -34,7 +34,7 @@ pub mod files {
     pub const GT_NORMAL: &str = "gt/normal.exr";
     /// Float32 Y: distance along -z, 0 where no surface.
     pub const GT_DEPTH: &str = "gt/depth.exr";
-    /// 8-bit labels, see [`MaterialLabel`].
+    /// 8-bit labels, see [`MaterialLabel`](crate::sample::MaterialLabel).
     pub const GT_MATERIAL: &str = "gt/material.png";
     /// 8-bit mask: 255 on transparent objects, else 0.
     pub const GT_TRANSPARENT: &str = "gt/transparent.png";

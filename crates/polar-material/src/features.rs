@@ -99,7 +99,7 @@ fn defined(s0: f32, s1: f32, s2: f32) -> bool {
     s0 > 0.0 && s1.is_finite() && s2.is_finite()
 }
 
-/// DoLP of a linear Stokes vector clamped to `[0, 1]`, 0 where not [`defined`].
+/// DoLP of a linear Stokes vector clamped to `[0, 1]`, 0 where not `defined`.
 pub fn dolp(s0: f32, s1: f32, s2: f32) -> f32 {
     if !defined(s0, s1, s2) {
         return 0.0;
@@ -107,7 +107,7 @@ pub fn dolp(s0: f32, s1: f32, s2: f32) -> f32 {
     (s1.hypot(s2) / s0).min(1.0)
 }
 
-/// AoLP of a linear Stokes vector in `[0, π)`, 0 where not [`defined`].
+/// AoLP of a linear Stokes vector in `[0, π)`, 0 where not `defined`.
 pub fn aolp(s0: f32, s1: f32, s2: f32) -> f32 {
     if !defined(s0, s1, s2) {
         return 0.0;

@@ -16,7 +16,7 @@
 //!    (enclosed regions, the edges around them, invalid pixels such as saturated
 //!    highlights inside an object) is the foreground, eroded by 3×3 (undoing the
 //!    dilation) and opened by 3×3 to drop thin edge lines;
-//! 4. of the edge-free interiors only object faces count ([`object_faces`]): those B
+//! 4. of the edge-free interiors only object faces count (`object_faces`): those B
 //!    holds (a tenth of the ring around them is B: a face inside its coherent rim),
 //!    and those polarized above the background (median DoLP twice the background's: a
 //!    glossy face whose AoLP varies too fast for B); with the edges near them or near B.
@@ -34,36 +34,36 @@
 //!    demosaicing residue), up to `Σg²⁻¹·(Σg)²` where it is one smooth field (an object).
 //!    Regions are `z` above Otsu's threshold of `z`, opened by 3×3, without components
 //!    smaller than the window (`π (2σ)²` pixels) and without those polarized no more
-//!    than the background and without an occluding-contour signature ([`object_like`]):
+//!    than the background and without an occluding-contour signature (`object_like`):
 //!    a floor's AoLP can be coherent where its DoLP is only noise and demosaicing
 //!    residue, and where the objects are few and small Otsu's threshold falls inside
 //!    that floor's coherence;
 //! 2. holes are filled unless an occluding contour bounds them: the diffuse DoLP peaks
 //!    at grazing, so around a hole seen through an object (a torus) the DoLP is highest
 //!    next to the hole, while around a patch facing the camera (low DoLP) it rises away
-//!    from it ([`fill_object_holes`]);
+//!    from it (`fill_object_holes`);
 //! 3. a hole is also left open when its median log brightness is closer to the
 //!    background's around the regions than to the region's around it
-//!    ([`looks_through`]): background seen through the object;
+//!    (`looks_through`): background seen through the object;
 //! 4. a region that reaches the image border (a glossy floor or wall may be coherent)
 //!    is kept only if its boundary shows the occluding-contour signature: the AoLP
 //!    parallel (diffuse) or perpendicular (specular) to the boundary's 2-D normal, i.e.
 //!    the DoLP-weighted mean of `cos 4Δ` (Δ = AoLP − normal direction) more than three
-//!    standard deviations above 0, its value for a random AoLP ([`has_contour`]).
+//!    standard deviations above 0, its value for a random AoLP (`has_contour`).
 //!
 //! **The union**: B's regions, and A's outside the holes B left open. A's edge-free
 //! interiors that B does not touch and that the rest of the foreground encloses are
-//! opened by the same brightness test ([`open_see_through_holes`]): edges also enclose
+//! opened by the same brightness test (`open_see_through_holes`): edges also enclose
 //! the hole of a torus. Components without any pixel of B or of an object face are
 //! dropped (specks; every object polarizes somewhere). Regions inside the frame are
 //! not held to the contour signature: on glossy objects the diffuse and specular parts
 //! cancel along stretches of the rim, and the shape prior checks it per boundary pixel
 //! instead (`crate::local`). Last, the gaps between a component and its convex hull that
 //! the component mostly borders and that are as bright as it are filled
-//! ([`fill_hull_gaps`]): a white object on a light floor is found as the open arcs of its
+//! (`fill_hull_gaps`): a white object on a light floor is found as the open arcs of its
 //! rim, its face toward the camera too weakly polarized and edged for either cue. Then
 //! the boundary pixels as bright as the background beside them rather than the object
-//! are given back to the background, twice ([`trim_boundary`]): the edges of A straddle
+//! are given back to the background, twice (`trim_boundary`): the edges of A straddle
 //! the silhouette.
 //!
 //! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
@@ -669,7 +669,7 @@ fn object_like(cues: &Cues, regions: Vec<bool>) -> Result<Vec<bool>, ShapeError>
 }
 
 /// Rayleigh statistic `z = |Σ g e^{2iα}|² / Σ g²` of the AoLP over a Gaussian window `g`
-/// ([`COHERENCE_SIGMA`]) of the valid pixels with a DoLP; 0 elsewhere. Its expectation
+/// (`COHERENCE_SIGMA`) of the valid pixels with a DoLP; 0 elsewhere. Its expectation
 /// is 1 for independent uniformly random angles.
 pub fn rayleigh_statistic(cues: &Cues) -> Result<Gray<f32>, ShapeError> {
     let (w, h) = (cues.width, cues.height);

@@ -9,7 +9,7 @@
 //!    has azimuth `−∇D` (smoothed) and zenith `asin(1 − D/R)` (exact for a sphere).
 //!    It starts the iterations everywhere but weighs in them only where the nearest
 //!    boundary shows the occluding-contour signature in its polarization
-//!    ([`verified_contour`]), so a cast shadow or a missed part of an object does not
+//!    (`verified_contour`), so a cast shadow or a missed part of an object does not
 //!    pull the normals toward a boundary that is not a silhouette.
 //! 2. Candidates per pixel, in the per-pixel Stokes frame: diffuse azimuths `AoLP`,
 //!    `AoLP + π` and specular ones `AoLP ± π/2`. Observed light mixes diffuse, specular
@@ -77,7 +77,7 @@ pub struct Prior {
     pub normal: Vec<Vector3<f64>>,
     /// Prior weight in `[0, 1]` (0 off the foreground or without any contour).
     pub weight: Vec<f64>,
-    /// The pixel's object is specular-dominated at its rim ([`specular_rims`]).
+    /// The pixel's object is specular-dominated at its rim (`specular_rims`).
     pub specular_rim: Vec<bool>,
 }
 
@@ -294,7 +294,7 @@ fn smooth_field(
 
 /// The occluding-boundary prior of step 1 (module doc). It starts the iterations
 /// everywhere, but weighs in them only where the nearest boundary is a verified
-/// occluding contour ([`verified_contour`]), or everywhere when no part of the boundary
+/// occluding contour (`verified_contour`), or everywhere when no part of the boundary
 /// is.
 pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
     let (w, h) = (cues.width, cues.height);

@@ -5,7 +5,7 @@
 //!    form an RGGB Bayer image at half resolution; OpenCV's bilinear Bayer demosaicing
 //!    (`COLOR_BayerBG2BGR`) of each gives R, G and B at every pixel of that angle, so each
 //!    colour becomes a full-resolution mosaic in the monochrome layout. Per sample, with
-//!    the rounding of [`mean2`]/[`mean4`]: its own colour kept; at red and blue the other
+//!    the rounding of `mean2`/`mean4`: its own colour kept; at red and blue the other
 //!    two from the four-neighbour cross (green) and the four diagonals; at green red and
 //!    blue from the left/right or up/down pair. OpenCV's border rule applies on the
 //!    half-resolution image: its outermost rows and columns copy their inner neighbours.

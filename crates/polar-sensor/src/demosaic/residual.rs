@@ -8,7 +8,7 @@
 //!    plus the mean of its four diagonal neighbours, which carry the orthogonal
 //!    polarizer (`I_θ + I_θ+90 = S0` for any linear Stokes vector; the intensity
 //!    correlation of Zhang et al., Opt. Lett. 41, 3435 (2016)).
-//!    The two pairs are balanced to the same mean over the frame ([`pair_gains`]):
+//!    The two pairs are balanced to the same mean over the frame (`pair_gains`):
 //!    real sensors' pair sums differ by a few percent.
 //! 2. Residuals `R = raw − G` at each sample hold only the polarization part
 //!    `½ (S1 cos 2θ + S2 sin 2θ)`, which stays smooth where `S0` has fine texture.
