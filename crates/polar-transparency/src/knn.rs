@@ -191,7 +191,7 @@ fn bracket(x: usize, nodes: &[usize], stride: usize) -> (usize, usize, f32) {
 /// Probability of transparent per pixel: the fraction of transparent points among the `k`
 /// nearest training points, on a grid of at most about [`MAX_QUERIES`] nodes, interpolated
 /// bilinearly in between (every pixel is a node on frames up to that size). `cues` are
-/// the cue maps of `obs`.
+/// the cue maps of `obs` (their `pixel_dolp` is not a feature and may be taken out).
 pub fn probability(
     clf: &KnnClassifier,
     obs: &Observation,

@@ -157,8 +157,8 @@ pub fn detect(
     {
         return Err(TransparencyError::Threshold(t));
     }
-    let maps = cues::cue_maps(obs)?;
-    let pixel_dolp = maps.pixel_dolp.clone();
+    let mut maps = cues::cue_maps(obs)?;
+    let pixel_dolp = std::mem::take(&mut maps.pixel_dolp);
     let (score, t) = match segmenter {
         Segmenter::Cues => {
             let score = cues::score(&maps, w, h);
