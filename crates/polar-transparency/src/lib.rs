@@ -11,11 +11,11 @@
 //! average out); it then thresholds the score
 //! (Otsu, or a given threshold), closes and opens the mask, fills holes (background
 //! components not touching the border), drops specks, replaces each component by its
-//! convex hull and trims the depolarized rim that the window added around it
-//! ([`WINDOW`](cues::WINDOW)), all with polar-imgproc. The hull is there because glass is polarized
-//! mostly along its rims and edges (reflection and transmission both grow toward
-//! grazing) and little where it faces the camera, so the seeds are open arcs around
-//! the object; glass objects (balls, slabs, cups, bottles) are mostly convex.
+//! convex hull and trims the depolarized rim that the window added around it, all with
+//! polar-imgproc. The hull is there because glass is polarized mostly along its rims and
+//! edges (reflection and transmission both grow toward grazing) and little where it faces
+//! the camera, so the seeds are open arcs around the object; glass objects (balls, slabs,
+//! cups, bottles) are mostly convex.
 //!
 //! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass. A
 //! region much darker than its surroundings is dropped ([`SEE_THROUGH`]: glass lets the
@@ -231,11 +231,10 @@ fn without_depolarized_rim(
     w: usize,
     h: usize,
 ) -> Result<Vec<bool>, TransparencyError> {
-    let side = cues::WINDOW / 2 * 2 + 1;
     let src = Gray::from_vec(w, h, mask.iter().map(|&b| f32::from(u8::from(b))).collect())
         .expect("size of the observation");
     let mut inner = Gray::new(w, h);
-    polar_imgproc::min_filter(&src, &mut inner, side, side)?;
+    polar_imgproc::min_filter(&src, &mut inner, cues::WINDOW, cues::WINDOW)?;
     let inner = inner.as_slice();
     Ok((0..w * h)
         .map(|k| mask[k] && (inner[k] > 0.5 || pixel_dolp[k] >= cues::HALF_DOLP))
