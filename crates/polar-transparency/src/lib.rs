@@ -8,10 +8,10 @@
 //! background of none. [`detect`] scores each pixel by cue maps ([`cues`]): the DoLP of
 //! the locally averaged Stokes vector, its coherence (that DoLP over the mean per-pixel
 //! DoLP: sensor noise and demosaicing artefacts at texture edges have random AoLP and
-//! average out); it then thresholds the score
-//! (Otsu, or a given threshold), closes and opens the mask, fills holes (background
-//! components not touching the border), drops specks, replaces each component by its
-//! convex hull and trims the depolarized rim that the window added around it, all with
+//! average out); it then thresholds the score ([`cue_threshold`]: Otsu's, bounded by the
+//! background's level; or a given threshold), closes and opens the mask, fills holes
+//! (background components not touching the border), drops specks, replaces each component
+//! by its convex hull and trims the depolarized rim that the window added around it, all with
 //! polar-imgproc. The hull is there because glass is polarized mostly along its rims and
 //! edges (reflection and transmission both grow toward grazing) and little where it faces
 //! the camera, so the seeds are open arcs around the object; glass objects (balls, slabs,
@@ -113,15 +113,32 @@ pub enum Segmenter {
 /// Options of [`detect`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TransparencyOptions {
-    /// Score threshold in `[0, 1]`; `None` = for the cues, Otsu's threshold of the score map,
-    /// floored at [`MIN_THRESHOLD`] so that a scene without glass is not split in two
-    /// anyway; for the kNN, [`KNN_THRESHOLD`].
+    /// Score threshold in `[0, 1]`; `None` = for the cues, [`cue_threshold`] of the score
+    /// map; for the kNN, [`KNN_THRESHOLD`].
     pub threshold: Option<f32>,
 }
 
 /// The Otsu threshold never goes below this score: a DoLP of a few percent coherent
 /// over a window is what depolarizing surfaces reach at most (see [`cues::score`]).
 pub const MIN_THRESHOLD: f32 = 0.3;
+
+/// Nor above this multiple of the frame's median score, the depolarizing background's
+/// level (most of a frame is background): where one object polarizes far more than
+/// another, Otsu splits the strong one from the rest and loses the weaker glass.
+pub const BACKGROUND_MULTIPLE: f32 = 5.0;
+
+/// The cue segmenter's default threshold: Otsu's threshold of the score map, at most
+/// [`BACKGROUND_MULTIPLE`] times its median, at least [`MIN_THRESHOLD`] (so that a scene
+/// without glass is not split in two anyway). On a clean frame the background's level is
+/// far below the floor and the floor decides; sensor noise raises that level, and Otsu
+/// with it.
+pub fn cue_threshold(score: &Gray<f32>) -> Result<f32, TransparencyError> {
+    let otsu = threshold_otsu(score)?;
+    let background = polar_image::quantile(score.as_slice().iter().copied(), 0.5).unwrap_or(0.0);
+    Ok(otsu
+        .min(BACKGROUND_MULTIPLE * background)
+        .max(MIN_THRESHOLD))
+}
 
 /// The kNN's default threshold on its vote for transparent. Above the majority vote: the
 /// training points are balanced per class, so the vote over-weights transparent pixels
@@ -164,7 +181,7 @@ pub fn detect(
             let score = cues::score(&maps, w, h);
             let t = match opts.threshold {
                 Some(t) => t,
-                None => threshold_otsu(&score)?.max(MIN_THRESHOLD),
+                None => cue_threshold(&score)?,
             };
             (score, t)
         }

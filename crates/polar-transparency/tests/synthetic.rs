@@ -11,7 +11,9 @@ use polar_learn::{Expect, KnnModel, LearnError};
 use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::{Observation, StokesPlanes};
 use polar_transparency::knn::{self, BUILTIN_MODEL, EXPECT, KnnClassifier};
-use polar_transparency::{MIN_WINDOWS, ON, Segmenter, TransparencyOptions, detect};
+use polar_transparency::{
+    MIN_THRESHOLD, MIN_WINDOWS, ON, Segmenter, TransparencyOptions, cue_threshold, detect,
+};
 use std::f64::consts::FRAC_PI_2;
 
 const N: usize = 96;
@@ -158,6 +160,32 @@ fn glass_polarized_along_an_open_arc_is_filled() {
     let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
     let iou = iou_with_disc(&out.mask);
     assert!(iou > 0.7, "IoU {iou}");
+}
+
+/// The cue threshold on score maps with three levels: a background (85 % of the pixels),
+/// weakly polarized glass at 0.35 (5 %) and strongly polarized glass at 0.95 (10 %). Otsu's
+/// threshold falls between the two glasses; on a clean background (score 0) it is capped
+/// down to the floor, which keeps the weak glass, while on a noisy one (score 0.15, as
+/// sensor noise gives a depolarizing floor) the cap does not bind.
+#[test]
+fn threshold_keeps_weak_glass_beside_strong_glass_on_a_clean_background() {
+    let map = |background: f32| {
+        let v = (0..10_000)
+            .map(|k| match k % 20 {
+                0 => 0.35,
+                1 | 2 => 0.95,
+                _ => background,
+            })
+            .collect();
+        Gray::from_vec(100, 100, v).unwrap()
+    };
+    let clean = map(0.0);
+    let otsu = polar_imgproc::threshold_otsu(&clean).unwrap();
+    assert!(otsu > 0.35, "Otsu {otsu} keeps the weak glass by itself");
+    assert_eq!(cue_threshold(&clean).unwrap(), MIN_THRESHOLD);
+    let noisy = map(0.15);
+    let otsu = polar_imgproc::threshold_otsu(&noisy).unwrap();
+    assert_eq!(cue_threshold(&noisy).unwrap(), otsu);
 }
 
 /// Coherently polarized specks smaller than [`MIN_WINDOWS`] averaging windows are noise,
