@@ -162,11 +162,11 @@ fn glass_polarized_along_an_open_arc_is_filled() {
     assert!(iou > 0.7, "IoU {iou}");
 }
 
-/// The cue threshold on score maps with three levels: a background (85 % of the pixels),
-/// weakly polarized glass at 0.35 (5 %) and strongly polarized glass at 0.95 (10 %). Otsu's
-/// threshold falls between the two glasses; on a clean background (score 0) it is capped
-/// down to the floor, which keeps the weak glass, while on a noisy one (score 0.15, as
-/// sensor noise gives a depolarizing floor) the cap does not bind.
+/// Score maps with three levels: a background over most of the frame, weakly polarized
+/// glass, and more strongly polarized glass covering more pixels than the weak one, so that
+/// Otsu's threshold falls between the two glasses. On a clean background the threshold is
+/// capped down to its floor, below the weak glass; on a background that sensor noise lifts
+/// the cap does not bind and Otsu's threshold stands.
 #[test]
 fn threshold_keeps_weak_glass_beside_strong_glass_on_a_clean_background() {
     let map = |background: f32| {
