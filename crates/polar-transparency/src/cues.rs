@@ -128,9 +128,16 @@ pub fn cue_maps(obs: &Observation) -> Result<CueMaps, TransparencyError> {
 /// The per-pixel transparency score in `[0, 1)` of the cue maps of a `w x h` frame (see
 /// the module docs).
 pub fn score(c: &CueMaps, w: usize, h: usize) -> Gray<f32> {
-    let s = par_map(w * h, |k| {
-        let e = c.dolp[k] * c.coherence[k];
-        e / (e + HALF_DOLP)
-    });
+    let s = par_map(w * h, |k| score_of(c.dolp[k] * c.coherence[k]));
     Gray::from_vec(w, h, s).expect("size of the cue maps")
+}
+
+/// The score `e / (e + HALF_DOLP)` of a coherent DoLP `e` (dolp · coherence).
+pub fn score_of(e: f32) -> f32 {
+    e / (e + HALF_DOLP)
+}
+
+/// The coherent DoLP whose score is `s` ([`score_of`] inverted; infinite at `s = 1`).
+pub fn coherent_dolp(s: f32) -> f32 {
+    HALF_DOLP * s / (1.0 - s)
 }

@@ -9,7 +9,7 @@
 //! the locally averaged Stokes vector, its coherence (that DoLP over the mean per-pixel
 //! DoLP: sensor noise and demosaicing artefacts at texture edges have random AoLP and
 //! average out); it then thresholds the score ([`cue_threshold`]: Otsu's, bounded by the
-//! background's level; or a given threshold), closes and opens the mask, fills holes
+//! background's level and by the noise's; or a given threshold), closes and opens the mask, fills holes
 //! (background components not touching the border), drops specks, replaces each component
 //! by its convex hull and trims the depolarized rim that the window added around it, all with
 //! polar-imgproc. The hull is there because glass is polarized mostly along its rims and
@@ -127,17 +127,56 @@ pub const MIN_THRESHOLD: f32 = 0.3;
 /// another, Otsu splits the strong one from the rest and loses the weaker glass.
 pub const BACKGROUND_MULTIPLE: f32 = 5.0;
 
+/// Sensor noise alone gives a window of unpolarized pixels a chance coherence (see
+/// [`cues::score`]), so a noisy frame's background scores above [`MIN_THRESHOLD`] in
+/// places. The threshold's coherent DoLP (`e` of [`cues::score`]) is therefore at least
+/// this multiple of the background's, read at the frame's median score: the top of a
+/// frame of pure noise, not its middle.
+pub const NOISE_MULTIPLE: f32 = 2.0;
+
+/// The noise floor is capped at this coherent DoLP: a frame polarized coherently nearly
+/// everywhere (a water surface or a pane filling the view) is one transparent surface,
+/// not noise.
+pub const NOISE_FLOOR_CAP: f32 = 0.075;
+
 /// The cue segmenter's default threshold: Otsu's threshold of the score map, at most
 /// [`BACKGROUND_MULTIPLE`] times its median, at least [`MIN_THRESHOLD`] (so that a scene
-/// without glass is not split in two anyway). On a clean frame the background's level is
-/// far below the floor and the floor decides; sensor noise raises that level, and Otsu
-/// with it.
-pub fn cue_threshold(score: &Gray<f32>) -> Result<f32, TransparencyError> {
+/// without glass is not split in two anyway) and at least the noise floor
+/// ([`NOISE_MULTIPLE`], [`NOISE_FLOOR_CAP`]). On a clean frame the background's level is
+/// far below the floors and [`MIN_THRESHOLD`] decides; sensor noise raises that level,
+/// Otsu with it, and on very noisy frames the noise floor.
+pub fn cue_threshold(score: &Gray<f32>) -> Result<Threshold, TransparencyError> {
     let otsu = threshold_otsu(score)?;
     let background = polar_image::quantile(score.as_slice().iter().copied(), 0.5).unwrap_or(0.0);
-    Ok(otsu
+    let bounded = otsu
         .min(BACKGROUND_MULTIPLE * background)
-        .max(MIN_THRESHOLD))
+        .max(MIN_THRESHOLD);
+    let noise =
+        cues::score_of((NOISE_MULTIPLE * cues::coherent_dolp(background)).min(NOISE_FLOOR_CAP));
+    Ok(Threshold {
+        value: bounded.max(noise),
+        noise_floor: noise > bounded,
+    })
+}
+
+/// The score threshold [`detect`] used.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Threshold {
+    /// Pixels scoring above it seed the mask.
+    pub value: f32,
+    /// The noise floor of [`cue_threshold`] set it: the frame's background scores high
+    /// (a dim or noisy frame), so weak glass may be lost with the noise.
+    pub noise_floor: bool,
+}
+
+impl Threshold {
+    /// A threshold given or fixed in advance.
+    fn fixed(value: f32) -> Self {
+        Self {
+            value,
+            noise_floor: false,
+        }
+    }
 }
 
 /// The kNN's default threshold on its vote for transparent. Above the majority vote: the
@@ -157,6 +196,8 @@ pub struct TransparencyMap {
     pub mask: Gray<u8>,
     /// Per-pixel score in `[0, 1]` (higher = more likely transparent).
     pub score: Gray<f32>,
+    /// The threshold applied to the score.
+    pub threshold: Threshold,
 }
 
 /// Detects transparent objects in `obs` with `segmenter`.
@@ -180,17 +221,17 @@ pub fn detect(
         Segmenter::Cues => {
             let score = cues::score(&maps, w, h);
             let t = match opts.threshold {
-                Some(t) => t,
+                Some(t) => Threshold::fixed(t),
                 None => cue_threshold(&score)?,
             };
             (score, t)
         }
         Segmenter::Knn(clf) => (
             knn::probability(clf, obs, maps)?,
-            opts.threshold.unwrap_or(KNN_THRESHOLD),
+            Threshold::fixed(opts.threshold.unwrap_or(KNN_THRESHOLD)),
         ),
     };
-    let seed: Vec<bool> = score.as_slice().iter().map(|&s| s > t).collect();
+    let seed: Vec<bool> = score.as_slice().iter().map(|&s| s > t.value).collect();
     let m = polar_imgproc::mask::clean(&seed, w, h)?;
     let m = polar_imgproc::mask::remove_small(&m, w, h, MIN_WINDOWS * cues::WINDOW.pow(2))?;
     let m = polar_imgproc::mask::convex_hull_objects(&m, w, h)?;
@@ -198,7 +239,11 @@ pub fn detect(
     let m = without_depolarized_rim(&m, &pixel_dolp, w, h)?;
     let mask = Gray::from_vec(w, h, m.iter().map(|&b| if b { ON } else { 0 }).collect())
         .expect("size of the observation");
-    Ok(TransparencyMap { mask, score })
+    Ok(TransparencyMap {
+        mask,
+        score,
+        threshold: t,
+    })
 }
 
 /// `mask` without the components whose median S0 is below [`SEE_THROUGH`] times the

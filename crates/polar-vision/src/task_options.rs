@@ -62,7 +62,7 @@ pub struct TaskArgs {
     #[arg(long, value_name = "FILE")]
     pub material_model: Option<PathBuf>,
     /// Transparent-object segmenter:
-    ///   cues     the cue score (coherent DoLP) with Otsu's threshold, capped by the background's level; no training
+    ///   cues     the cue score (coherent DoLP) with Otsu's threshold, bounded by the background's level; no training
     ///   learned  k nearest neighbours over per-pixel cue features (--transparent-model)
     #[arg(verbatim_doc_comment)]
     #[arg(long, value_name = "NAME", default_value = "cues", value_parser = parse_name::<TransparentMethod>)]

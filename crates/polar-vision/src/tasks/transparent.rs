@@ -30,6 +30,13 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     if let Segmenter::Knn(m) = &segmenter {
         outcome.messages.push(knn_message(m.model()));
     }
+    if map.threshold.noise_floor {
+        outcome.messages.push(format!(
+            "score threshold raised to {:.2} by the noise: the frame's background scores \
+             high (a dim or noisy frame), so weakly polarized glass may be missed",
+            map.threshold.value
+        ));
+    }
     if let Some(gt) = &ctx.gt.transparent {
         let opaque = ctx.gt.material.as_ref().map(opaque_objects);
         let m = mask_metrics(&map.mask, gt, opaque.as_ref())
