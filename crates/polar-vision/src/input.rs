@@ -241,7 +241,7 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
     let pattern = mosaic_pattern(path, args.pattern)?;
     let mut timings = Timings::default();
     let png = timings.time("read raw.png", || polar_io::read_mosaic(path))?;
-    let (raw, level, warning) = timings.time("exposure checks", || {
+    let (raw, level, warnings) = timings.time("exposure checks", || {
         let (raw, bits) = significant_bits(path, png, bits, args.align)?;
         let (w, h) = raw.size();
         pattern
@@ -252,8 +252,8 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
                 source,
             })?;
         let level = saturation_level(&raw, bits);
-        let warning = check_exposure(path, &raw, bits, level)?;
-        Ok::<_, CliError>((raw, level, warning))
+        let warnings = check_exposure(path, &raw, bits, level)?;
+        Ok::<_, CliError>((raw, level, warnings))
     })?;
     let demosaic = "demosaic + products";
     let (planes, flags, colors) = match pattern {
@@ -277,7 +277,7 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
         obs: Observation::new(planes, CameraModel::Orthographic).with_flags(flags),
         colors,
         timings,
-        warnings: warning.into_iter().collect(),
+        warnings,
     })
 }
 
@@ -372,13 +372,13 @@ fn significant_bits(
     Ok((raw, bits))
 }
 
-/// Rejects frames without usable light; a warning for partly saturated ones.
+/// Rejects frames without usable light; warnings for partly saturated and for dim ones.
 fn check_exposure(
     path: &Path,
     raw: &Mosaic<u16>,
     bits: u8,
     level: u32,
-) -> Result<Option<String>, CliError> {
+) -> Result<Vec<String>, CliError> {
     if raw.as_slice().iter().all(|&v| v == 0) {
         return Err(CliError::AllZero(path.to_owned()));
     }
@@ -391,19 +391,78 @@ fn check_exposure(
             bits,
         });
     }
-    Ok((saturated > 0).then(|| {
+    let saturation = (saturated > 0).then(|| {
         format!(
             "{}: {saturated} of {n} pixels ({:.3}%) are saturated at {level} DN; flagged in the mask",
             path.display(),
             100.0 * saturated as f64 / n as f64
         )
-    }))
+    });
+    Ok(saturation
+        .into_iter()
+        .chain(dim_warning(path, raw))
+        .collect())
+}
+
+/// Below this many DN at the 90th percentile a frame is too dim for polarization: the
+/// rounding to whole DN alone gives unpolarized light a DoLP of `≈ 0.26 / DN`
+/// ([`ROUNDING_DOLP`]), above the few percent a diffuse surface shows facing the camera.
+pub const DIM_LEVEL_DN: u16 = 16;
+
+/// The mean DoLP that rounding to whole DN gives unpolarized light of one DN per pixel:
+/// each polarizer sample is off by a uniform error of variance 1/12, so `S1 = I0 − I90`
+/// and `S2` have `σ = √(2/12)`, and with `S0 ≈ 2 I` the DoLP is Rayleigh-distributed with
+/// mean `σ √(π/2) / (2 I)`.
+pub const ROUNDING_DOLP: f64 = 0.2558;
+
+/// A warning when nine pixels in ten are below [`DIM_LEVEL_DN`].
+fn dim_warning(path: &Path, raw: &Mosaic<u16>) -> Option<String> {
+    let mut histogram = vec![0usize; usize::from(DIM_LEVEL_DN)];
+    for &v in raw.as_slice().iter().filter(|&&v| v < DIM_LEVEL_DN) {
+        histogram[usize::from(v)] += 1;
+    }
+    let n = raw.as_slice().len();
+    // The smallest level at or below which nine pixels in ten lie, if below the limit.
+    let mut below = 0;
+    let p90 = histogram.iter().position(|&c| {
+        below += c;
+        10 * below >= 9 * n
+    })?;
+    Some(format!(
+        "{}: nine pixels in ten are at {p90} DN or below: rounding to whole DN alone gives \
+         unpolarized light a DoLP of about {:.2} there, so polarization results are \
+         unreliable (expose longer or average frames)",
+        path.display(),
+        ROUNDING_DOLP / (p90.max(1) as f64)
+    ))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use serde_json::json;
+
+    #[test]
+    fn dim_frames_are_warned_about_at_the_90th_percentile() {
+        let path = Path::new("raw.png");
+        // 100 pixels: `dark` of them at 3 DN, the rest at `bright` DN.
+        let frame = |dark: usize, bright: u16| {
+            let v = (0..100)
+                .map(|k| if k < dark { 3 } else { bright })
+                .collect();
+            Mosaic::from_vec(10, 10, v).unwrap()
+        };
+        let warning = dim_warning(path, &frame(90, 200)).expect("nine in ten at 3 DN");
+        assert!(warning.contains("at 3 DN or below"), "{warning}");
+        assert!(warning.contains("about 0.09"), "{warning}");
+        // A dark background under a tenth of well-exposed pixels is no dim frame...
+        assert_eq!(dim_warning(path, &frame(89, 200)), None);
+        // ...nor is a frame at the limit, while one a DN below it is.
+        assert_eq!(dim_warning(path, &frame(0, DIM_LEVEL_DN)), None);
+        assert!(dim_warning(path, &frame(0, DIM_LEVEL_DN - 1)).is_some());
+        let warnings = check_exposure(path, &frame(95, 4095), 12, 4095).unwrap();
+        assert_eq!(warnings.len(), 2, "saturation and dimness: {warnings:?}");
+    }
 
     #[test]
     fn saturation_at_a_smaller_adc_top_is_found_only_when_repeated() {
