@@ -26,8 +26,11 @@
 //!
 //! [`detect`] runs one of two segmenters ([`Segmenter`]): the cue score above, which needs
 //! no training, or a k-nearest-neighbour classifier over per-pixel features built on the
-//! same cues ([`knn`], trained by `polar-vision train transparent`); both end in the same
-//! mask clean-up.
+//! same cues ([`knn`], trained by `polar-vision train transparent`), whose vote counts only
+//! where the cue score passes its own threshold: glass polarizes the light it returns, so
+//! the vote decides which coherently polarized regions are glass, not whether there is
+//! polarization (left to itself, a model trained on rendered scenes strays on frames
+//! unlike them). Both end in the same mask clean-up.
 
 pub mod cues;
 pub mod knn;
@@ -217,21 +220,30 @@ pub fn detect(
     }
     let mut maps = cues::cue_maps(obs)?;
     let pixel_dolp = std::mem::take(&mut maps.pixel_dolp);
-    let (score, t) = match segmenter {
+    let cue_score = cues::score(&maps, w, h);
+    let (score, t, seed) = match segmenter {
         Segmenter::Cues => {
-            let score = cues::score(&maps, w, h);
             let t = match opts.threshold {
                 Some(t) => Threshold::fixed(t),
-                None => cue_threshold(&score)?,
+                None => cue_threshold(&cue_score)?,
             };
-            (score, t)
+            let seed: Vec<bool> = cue_score.as_slice().iter().map(|&s| s > t.value).collect();
+            (cue_score, t, seed)
         }
-        Segmenter::Knn(clf) => (
-            knn::probability(clf, obs, maps)?,
-            Threshold::fixed(opts.threshold.unwrap_or(KNN_THRESHOLD)),
-        ),
+        Segmenter::Knn(clf) => {
+            // The vote picks among the coherently polarized pixels, not beyond them.
+            let polarized = cue_threshold(&cue_score)?;
+            let t = Threshold {
+                value: opts.threshold.unwrap_or(KNN_THRESHOLD),
+                noise_floor: polarized.noise_floor,
+            };
+            let p = knn::probability(clf, obs, maps)?;
+            let seed: Vec<bool> = (0..w * h)
+                .map(|k| p.as_slice()[k] > t.value && cue_score.as_slice()[k] > polarized.value)
+                .collect();
+            (p, t, seed)
+        }
     };
-    let seed: Vec<bool> = score.as_slice().iter().map(|&s| s > t.value).collect();
     let m = polar_imgproc::mask::clean(&seed, w, h)?;
     let m = polar_imgproc::mask::remove_small(&m, w, h, MIN_WINDOWS * cues::WINDOW.pow(2))?;
     let m = polar_imgproc::mask::convex_hull_objects(&m, w, h)?;

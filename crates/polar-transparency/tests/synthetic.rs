@@ -463,6 +463,39 @@ fn learned_separates_coherent_glass_from_a_depolarized_background() {
     assert_eq!(on, 0, "{on} pixels called transparent");
 }
 
+/// The vote counts only where the cue score passes its threshold: a model trained with the
+/// labels swapped (the depolarized backdrop as glass) votes transparent over a backdrop
+/// of texture alone, and still nothing is marked there.
+#[test]
+fn learned_votes_only_among_polarized_pixels() {
+    let (obs, truth) = noisy_glass_scene(48.0, 48.0, 30.0);
+    let swapped = Gray::from_vec(
+        N,
+        N,
+        truth
+            .as_slice()
+            .iter()
+            .map(|&v| if v == ON { 0 } else { ON })
+            .collect(),
+    )
+    .unwrap();
+    let (mut points, mut classes) = (Vec::new(), Vec::new());
+    knn::add_training_pixels(&obs, &swapped, &mut points, &mut classes).unwrap();
+    let model =
+        KnnModel::fit_balanced(EXPECT, 7, &points, &classes, 2000, 1, Default::default()).unwrap();
+    let knn = Segmenter::Knn(Arc::new(
+        KnnClassifier::new(model, Path::new("mem")).unwrap(),
+    ));
+    let (background, _) = noisy_glass_scene(-100.0, -100.0, 1.0);
+    let out = detect(&background, &knn, &TransparencyOptions::default()).unwrap();
+    let votes = out.score.as_slice().iter().filter(|&&p| p > 0.7).count();
+    assert!(
+        votes > N * N / 2,
+        "the swapped model votes for the backdrop: {votes}"
+    );
+    assert!(out.mask.as_slice().iter().all(|&v| v == 0));
+}
+
 /// Scaling S0, S1, S2 by 37 changes no feature beyond float rounding (every feature is a
 /// ratio) and gives the builtin model's identical mask.
 #[test]

@@ -63,7 +63,7 @@ pub struct TaskArgs {
     pub material_model: Option<PathBuf>,
     /// Transparent-object segmenter:
     ///   cues     the cue score (coherent DoLP) with Otsu's threshold, bounded by the background's level; no training
-    ///   learned  k nearest neighbours over per-pixel cue features (--transparent-model)
+    ///   learned  k nearest neighbours over per-pixel cue features (--transparent-model), voting among the pixels the cue score passes
     #[arg(verbatim_doc_comment)]
     #[arg(long, value_name = "NAME", default_value = "cues", value_parser = parse_name::<TransparentMethod>)]
     pub transparent_method: TransparentMethod,
