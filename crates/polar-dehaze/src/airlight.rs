@@ -132,22 +132,27 @@ impl AngleField {
         (0.5 * s.atan2(c)).rem_euclid(std::f64::consts::PI)
     }
 
-    /// Projected polarization `P = S1 cos 2alpha + S2 sin 2alpha` per pixel.
-    pub fn project(&self, s1: &Gray<f32>, s2: &Gray<f32>) -> Gray<f32> {
+    /// The linear polarization in the airlight's frame, per pixel: along its direction
+    /// `P = S1 cos 2alpha + S2 sin 2alpha` and across it `Q = S2 cos 2alpha − S1 sin 2alpha`
+    /// (zero for airlight and unpolarized light).
+    pub fn project(&self, s1: &Gray<f32>, s2: &Gray<f32>) -> (Gray<f32>, Gray<f32>) {
         let (w, h) = s1.size();
-        let mut out = Gray::new(w, h);
-        out.as_mut_slice()
+        let (mut along, mut across) = (Gray::new(w, h), Gray::new(w, h));
+        along
+            .as_mut_slice()
             .par_chunks_mut(w.max(1))
+            .zip(across.as_mut_slice().par_chunks_mut(w.max(1)))
             .enumerate()
-            .for_each(|(y, row)| {
+            .for_each(|(y, (p_row, q_row))| {
                 let yn = norm_coord(y, h);
-                for (x, o) in row.iter_mut().enumerate() {
+                for (x, (p, q)) in p_row.iter_mut().zip(q_row.iter_mut()).enumerate() {
                     let (c, s) = self.direction(norm_coord(x, w), yn);
                     let k = y * w + x;
-                    *o = (f64::from(s1.as_slice()[k]) * c + f64::from(s2.as_slice()[k]) * s) as f32;
+                    let (a, b) = (f64::from(s1.as_slice()[k]), f64::from(s2.as_slice()[k]));
+                    (*p, *q) = ((a * c + b * s) as f32, (b * c - a * s) as f32);
                 }
             });
-        out
+        (along, across)
     }
 }
 

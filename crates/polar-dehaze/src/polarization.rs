@@ -10,6 +10,17 @@
 //! the local airlight instead of amplifying the misfit of `A_inf`.
 //! The raw `t` is left unclamped (noise makes it leave `[0, 1]`): clamping before the
 //! guided filter would bias its local means (towards 0.5 where the truth is 0 or 1).
+//!
+//! Objects may polarize the light they send themselves (glossy surfaces, glass, water),
+//! each at its own angle, which the model above would read as airlight. Airlight has no
+//! component across its direction, `Q = S2 cos 2alpha − S1 sin 2alpha`, so `|Q|` beyond
+//! the noise is evidence of such light, and `P` is reduced by [`ACROSS_WEIGHT`] times it
+//! before `A = P / p`: a pixel polarized more than `atan(1/2)/2 ≈ 13°` off the airlight's
+//! angle counts as no airlight at all. On a haze-free frame the polarized objects are then
+//! mostly left as they are; in haze such an object is dehazed less than its distance asks
+//! (its airlight is underestimated); an object whose angle matches the airlight's is
+//! still read as haze, and where the angle field itself follows a large polarized object
+//! (no haze around it to hold the field) nothing tells the two apart.
 
 use polar_image::Gray;
 use rayon::prelude::*;
@@ -26,6 +37,16 @@ use crate::{
 /// copying the guide's noise into it.
 pub const NOISE_EPS_FACTOR: f32 = 9.0;
 
+/// Weight of the polarization across the airlight's direction taken off the part along it
+/// (module doc).
+pub const ACROSS_WEIGHT: f32 = 2.0;
+
+/// `|Q|` within this many of its noise's standard deviations is taken as no evidence. That
+/// deviation is the larger of `Q`'s over the frame ([`robust_sigma`]: noise, and the angle
+/// field's misfit) and `√2` times the normalised S0's ([`Normalized::noise`]: `S1` and `S2`
+/// are differences of two samples, S0 half the sum of four).
+pub const ACROSS_NOISE_MARGIN: f32 = 2.0;
+
 /// Below this fraction of sky-like blocks a warning says that `A_inf` may be too low.
 pub const MIN_SKY_FRACTION: f32 = 0.005;
 
@@ -41,13 +62,13 @@ pub fn transmission(input: &Normalized, opts: &DehazeOptions) -> Result<RawEstim
         return fallback(input, opts, p);
     };
     let (w, h) = input.s0.size();
-    let proj = est.field.project(&input.s1, &input.s2);
+    let proj = airlight_projection(est, input);
     let (p_inf, a_field) = polarized_infinity(est, w, h);
     let t: Vec<f32> = (0..w * h)
         .into_par_iter()
         .map(|k| {
             if input.valid[k] {
-                1.0 - proj.as_slice()[k] / p_inf[k]
+                1.0 - proj[k] / p_inf[k]
             } else {
                 f32::NAN
             }
@@ -63,6 +84,20 @@ pub fn transmission(input: &Normalized, opts: &DehazeOptions) -> Result<RawEstim
         guided_eps: opts.guided_eps.max(NOISE_EPS_FACTOR * input.noise.powi(2)),
         warnings: sky_warning(est),
     })
+}
+
+/// `p A` per pixel: the polarization along the airlight's direction less [`ACROSS_WEIGHT`]
+/// times the part across it beyond the noise (module doc).
+fn airlight_projection(est: &AirlightEstimate, input: &Normalized) -> Vec<f32> {
+    let (along, across) = est.field.project(&input.s1, &input.s2);
+    let noise = ACROSS_NOISE_MARGIN
+        * robust_sigma(&across, &input.valid).max(std::f32::consts::SQRT_2 * input.noise);
+    along
+        .as_slice()
+        .par_iter()
+        .zip(across.as_slice())
+        .map(|(p, q)| p - ACROSS_WEIGHT * (q.abs() - noise).max(0.0))
+        .collect()
 }
 
 /// `P_inf = p A_inf` per pixel, and `A_inf` per pixel, from the sky planes where sky was
@@ -128,4 +163,16 @@ fn fallback(input: &Normalized, opts: &DehazeOptions, p: f32) -> Result<RawEstim
             })
         }
     }
+}
+
+/// Robust standard deviation `1.4826 median |v|` of a zero-mean plane over the valid pixels
+/// (0 without any).
+fn robust_sigma(v: &Gray<f32>, valid: &[bool]) -> f32 {
+    let abs = v
+        .as_slice()
+        .iter()
+        .zip(valid)
+        .filter(|(_, ok)| **ok)
+        .map(|(x, _)| x.abs());
+    1.4826 * polar_image::quantile(abs, 0.5).unwrap_or(0.0)
 }

@@ -221,6 +221,34 @@ fn haze_free_unpolarized_input_is_left_unchanged_with_identity_fallback() {
     assert!(out.warnings.iter().any(|w| w.contains("left unchanged")));
 }
 
+/// A near glossy object in a hazy scene: no haze in front of it (t = 1), but it polarizes
+/// its own light (DoLP 0.15) at 30° from the airlight's angle. Half of that polarization
+/// lies along the airlight's direction and alone would read as haze; the part across
+/// it, which airlight never has, marks it as the object's own, and the object is left
+/// nearly as it is.
+#[test]
+fn a_near_object_polarized_off_the_airlights_angle_is_not_haze() {
+    let mut scene = Haze::standard(16, 0.3);
+    let object = |k: usize| (50..70).contains(&(k / scene.w)) && (30..60).contains(&(k % scene.w));
+    for k in (0..scene.t.len()).filter(|&k| object(k)) {
+        scene.t[k] = 1.0;
+    }
+    let (s0, mut s1, mut s2) = scene.planes();
+    for k in (0..s0.len()).filter(|&k| object(k)) {
+        let angle = 2.0 * (scene.alpha[k] + 30f32.to_radians());
+        s1[k] += 0.15 * s0[k] * angle.cos();
+        s2[k] += 0.15 * s0[k] * angle.sin();
+    }
+    let obs = observation(scene.w, scene.h, s0, s1, s2);
+    let out = dehaze(&obs, &DehazeOptions::default()).unwrap();
+    assert_eq!(out.method, Method::Polarization);
+    // Away from the outline, which the guided filter blends with the haze around.
+    let inner = |k: usize| (54..66).contains(&(k / scene.w)) && (34..56).contains(&(k % scene.w));
+    let t = out.transmission.as_slice();
+    let t_object = mean_err(t, &vec![0.0; t.len()], inner);
+    assert!(t_object > 0.95, "mean t on the object {t_object}");
+}
+
 #[test]
 fn haze_free_input_gives_t_near_one_with_dark_channel_fallback() {
     // Haze-free with dark squares in every 15x15 patch: the dark channel is 0.03 / A with
@@ -360,7 +388,9 @@ fn global_scale_37_gives_identical_transmission_and_scaled_radiance() {
         };
         let (ra, rb) = (dehaze(&a, &opts).unwrap(), dehaze(&b, &opts).unwrap());
         // Normalising by s0_scale rounds S0 * 37 / (q * 37) and S0 / q differently by an
-        // ulp; that is the only difference, so 1e-5 bounds it after the filters.
+        // ulp; that is the only difference, so 1e-5 bounds it after the filters. The
+        // radiance `(S0 - A) / t + A` of a dark square nearly cancels (S0 - A a
+        // three-thousandth of S0), which scales that ulp up: 3e-4 relative.
         let et = max_err(
             ra.transmission.as_slice(),
             rb.transmission.as_slice(),
@@ -373,7 +403,7 @@ fn global_scale_37_gives_identical_transmission_and_scaled_radiance() {
                     / (rb.radiance.as_slice()[k].abs() + 37.0)
             })
             .fold(0.0, f32::max);
-        assert!(er < 1e-4, "{method}: radiance relative difference {er}");
+        assert!(er < 3e-4, "{method}: radiance relative difference {er}");
         assert!((ra.airlight_inf * 37.0 / rb.airlight_inf - 1.0).abs() < 1e-5);
         assert_eq!(ra.airlight_dolp, rb.airlight_dolp);
     }
