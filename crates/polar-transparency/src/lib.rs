@@ -9,13 +9,13 @@
 //! the locally averaged Stokes vector, its coherence (that DoLP over the mean per-pixel
 //! DoLP: sensor noise and demosaicing artefacts at texture edges have random AoLP and
 //! average out); it then thresholds the score ([`cue_threshold`]: Otsu's, bounded by the
-//! background's level and by the noise's; or a given threshold), closes and opens the mask, fills holes
-//! (background components not touching the border), drops specks, replaces each component
-//! by its convex hull and trims the depolarized rim that the window added around it, all with
-//! polar-imgproc. The hull is there because glass is polarized mostly along its rims and
-//! edges (reflection and transmission both grow toward grazing) and little where it faces
-//! the camera, so the seeds are open arcs around the object; glass objects (balls, slabs,
-//! cups, bottles) are mostly convex.
+//! background's level and by the noise's; or a given threshold), closes and opens the
+//! mask, fills holes (background components not touching the border), drops specks,
+//! replaces each component by its convex hull and trims the depolarized rim that the
+//! window added around it, all with polar-imgproc. The hull is there because glass is
+//! polarized mostly along its rims and edges (reflection and transmission both grow toward
+//! grazing) and little where it faces the camera, so the seeds are open arcs around the
+//! object; glass objects (balls, slabs, cups, bottles) are mostly convex.
 //!
 //! Opaque shiny objects polarize too: a dark glossy dielectric as strongly as glass. A
 //! region much darker than its surroundings is dropped ([`SEE_THROUGH`]: glass lets the
