@@ -42,9 +42,9 @@ pub const NOISE_EPS_FACTOR: f32 = 9.0;
 pub const ACROSS_WEIGHT: f32 = 2.0;
 
 /// `|Q|` within this many of its noise's standard deviations is taken as no evidence. That
-/// deviation is the larger of `Q`'s over the frame ([`robust_sigma`]: noise, and the angle
-/// field's misfit) and `√2` times the normalised S0's ([`Normalized::noise`]: `S1` and `S2`
-/// are differences of two samples, S0 half the sum of four).
+/// deviation is the larger of `Q`'s robust one over the frame (`1.4826 median |Q|`: noise,
+/// and the angle field's misfit) and `√2` times the normalised S0's ([`Normalized::noise`]:
+/// `S1` and `S2` are differences of two samples, S0 half the sum of four).
 pub const ACROSS_NOISE_MARGIN: f32 = 2.0;
 
 /// Below this fraction of sky-like blocks a warning says that `A_inf` may be too low.
