@@ -372,7 +372,8 @@ fn significant_bits(
     Ok((raw, bits))
 }
 
-/// Rejects frames without usable light; warnings for partly saturated and for dim ones.
+/// Rejects frames without usable light; warnings for partly saturated and dim frames and
+/// for a polarizer channel far darker than the others.
 fn check_exposure(
     path: &Path,
     raw: &Mosaic<u16>,
@@ -401,7 +402,42 @@ fn check_exposure(
     Ok(saturation
         .into_iter()
         .chain(dim_warning(path, raw))
+        .chain(dark_channel_warning(path, raw))
         .collect())
+}
+
+/// A polarizer channel (one position of the 2×2 super-pixel, in mono and colour layouts
+/// alike) whose mean is below this share of the brightest channel's: no scene light gives
+/// that over a whole frame (it takes a DoLP above 0.8 everywhere), a dead channel, a wrong
+/// layout or a bit-unpacking error does.
+pub const DARK_CHANNEL_SHARE: f64 = 0.1;
+
+/// A warning when one polarizer channel is far darker than the others
+/// ([`DARK_CHANNEL_SHARE`]).
+fn dark_channel_warning(path: &Path, raw: &Mosaic<u16>) -> Option<String> {
+    let (w, h) = raw.size();
+    let mut sums = [0.0f64; 4];
+    for (k, &v) in raw.as_slice().iter().enumerate() {
+        sums[(k / w % 2) * 2 + k % w % 2] += f64::from(v);
+    }
+    let count = (w * h / 4).max(1) as f64;
+    let means = sums.map(|s| s / count);
+    let brightest = means.iter().copied().fold(0.0, f64::max);
+    let (dark, mean) = means
+        .iter()
+        .copied()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    (mean < DARK_CHANNEL_SHARE * brightest).then(|| {
+        format!(
+            "{}: the polarizer at row {}, column {} of each 2x2 super-pixel reads {mean:.1} DN on \
+             average, the brightest channel {brightest:.1} DN: a dead channel, a wrong layout \
+             or a bit-unpacking error; polarization results are unreliable",
+            path.display(),
+            dark / 2,
+            dark % 2
+        )
+    })
 }
 
 /// Below this many DN at the 90th percentile a frame is too dim for polarization: the
@@ -462,6 +498,29 @@ mod tests {
         assert!(dim_warning(path, &frame(0, DIM_LEVEL_DN - 1)).is_some());
         let warnings = check_exposure(path, &frame(95, 4095), 12, 4095).unwrap();
         assert_eq!(warnings.len(), 2, "saturation and dimness: {warnings:?}");
+    }
+
+    #[test]
+    fn a_dark_polarizer_channel_is_warned_about() {
+        let path = Path::new("raw.png");
+        // 8x8, every channel at 1000 DN but the one at row `r`, column 1 of the super-pixel.
+        let frame = |r: usize, level: u16| {
+            let v = (0..64)
+                .map(|k| {
+                    if k / 8 % 2 == r && k % 2 == 1 {
+                        level
+                    } else {
+                        1000
+                    }
+                })
+                .collect();
+            Mosaic::from_vec(8, 8, v).unwrap()
+        };
+        let warning = dark_channel_warning(path, &frame(1, 0)).expect("a dead channel");
+        assert!(warning.contains("row 1, column 1"), "{warning}");
+        assert!(dark_channel_warning(path, &frame(0, 90)).is_some());
+        // A DoLP of 0.8 over the whole frame: the darkest channel at 0.11 of the brightest.
+        assert_eq!(dark_channel_warning(path, &frame(0, 111)), None);
     }
 
     #[test]
