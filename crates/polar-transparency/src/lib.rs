@@ -162,24 +162,14 @@ pub fn cue_threshold(score: &Gray<f32>) -> Result<Threshold, TransparencyError> 
     })
 }
 
-/// The score threshold [`detect`] used.
+/// A cue-score threshold ([`cue_threshold`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Threshold {
-    /// Pixels scoring above it seed the mask.
+    /// Pixels scoring above it pass.
     pub value: f32,
-    /// The noise floor of [`cue_threshold`] set it: the frame's background scores high
-    /// (a dim or noisy frame), so weak glass may be lost with the noise.
+    /// The noise floor set it: the frame's background scores high (a dim or noisy frame),
+    /// so weak glass may be lost with the noise.
     pub noise_floor: bool,
-}
-
-impl Threshold {
-    /// A threshold given or fixed in advance.
-    fn fixed(value: f32) -> Self {
-        Self {
-            value,
-            noise_floor: false,
-        }
-    }
 }
 
 /// The kNN's default threshold on its vote for transparent. Above the majority vote: the
@@ -199,8 +189,11 @@ pub struct TransparencyMap {
     pub mask: Gray<u8>,
     /// Per-pixel score in `[0, 1]` (higher = more likely transparent).
     pub score: Gray<f32>,
-    /// The threshold applied to the score.
-    pub threshold: Threshold,
+    /// The threshold applied to [`Self::score`].
+    pub threshold: f32,
+    /// The cue-score threshold every seed passed, where the noise floor of
+    /// [`cue_threshold`] set it (for either segmenter).
+    pub noise_floor: Option<f32>,
 }
 
 /// Detects transparent objects in `obs` with `segmenter`.
@@ -221,25 +214,29 @@ pub fn detect(
     let mut maps = cues::cue_maps(obs)?;
     let pixel_dolp = std::mem::take(&mut maps.pixel_dolp);
     let cue_score = cues::score(&maps, w, h);
-    let (score, t, seed) = match segmenter {
+    // Every seed passes the cue score's bar: a given threshold for the cues, else
+    // `cue_threshold`; the kNN's vote picks among the coherently polarized pixels.
+    let bar = match (segmenter, opts.threshold) {
+        (Segmenter::Cues, Some(value)) => Threshold {
+            value,
+            noise_floor: false,
+        },
+        _ => cue_threshold(&cue_score)?,
+    };
+    let (score, threshold, seed) = match segmenter {
         Segmenter::Cues => {
-            let t = match opts.threshold {
-                Some(t) => Threshold::fixed(t),
-                None => cue_threshold(&cue_score)?,
-            };
-            let seed: Vec<bool> = cue_score.as_slice().iter().map(|&s| s > t.value).collect();
-            (cue_score, t, seed)
+            let seed: Vec<bool> = cue_score
+                .as_slice()
+                .iter()
+                .map(|&s| s > bar.value)
+                .collect();
+            (cue_score, bar.value, seed)
         }
         Segmenter::Knn(clf) => {
-            // The vote picks among the coherently polarized pixels, not beyond them.
-            let polarized = cue_threshold(&cue_score)?;
-            let t = Threshold {
-                value: opts.threshold.unwrap_or(KNN_THRESHOLD),
-                noise_floor: polarized.noise_floor,
-            };
+            let t = opts.threshold.unwrap_or(KNN_THRESHOLD);
             let p = knn::probability(clf, obs, maps)?;
-            let seed: Vec<bool> = (0..w * h)
-                .map(|k| p.as_slice()[k] > t.value && cue_score.as_slice()[k] > polarized.value)
+            let seed: Vec<bool> = (p.as_slice().iter().zip(cue_score.as_slice()))
+                .map(|(&vote, &s)| vote > t && s > bar.value)
                 .collect();
             (p, t, seed)
         }
@@ -254,7 +251,8 @@ pub fn detect(
     Ok(TransparencyMap {
         mask,
         score,
-        threshold: t,
+        threshold,
+        noise_floor: bar.noise_floor.then_some(bar.value),
     })
 }
 

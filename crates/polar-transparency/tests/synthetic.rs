@@ -233,7 +233,12 @@ fn heavy_noise_on_a_depolarizing_frame_is_no_glass() {
         "the noise is too weak to test anything"
     );
     assert!(out.mask.as_slice().iter().all(|&v| v == 0));
-    assert!(out.threshold.noise_floor);
+    assert!(out.noise_floor.is_some());
+    // The learned segmenter's seeds pass the same cue bar, and it reports that bar.
+    let knn = Segmenter::Knn(Arc::new(trained_on_one_scene()));
+    let learned = detect(&backdrop, &knn, &TransparencyOptions::default()).unwrap();
+    assert_eq!(learned.noise_floor, out.noise_floor);
+    assert!(learned.mask.as_slice().iter().all(|&v| v == 0));
     let glass = with_stokes_noise(&glass_scene(), 0.15);
     let out = detect(&glass, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
     let iou = iou_with_disc(&out.mask);

@@ -30,11 +30,10 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     if let Segmenter::Knn(m) = &segmenter {
         outcome.messages.push(knn_message(m.model()));
     }
-    if map.threshold.noise_floor {
+    if let Some(bar) = map.noise_floor {
         outcome.messages.push(format!(
-            "score threshold raised to {:.2} by the noise: the frame's background scores \
-             high (a dim or noisy frame), so weakly polarized glass may be missed",
-            map.threshold.value
+            "cue score threshold raised to {bar:.2} by the noise: the frame's background \
+             scores high (a dim or noisy frame), so weakly polarized glass may be missed"
         ));
     }
     if let Some(gt) = &ctx.gt.transparent {
