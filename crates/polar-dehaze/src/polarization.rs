@@ -165,7 +165,7 @@ fn fallback(input: &Normalized, opts: &DehazeOptions, p: f32) -> Result<RawEstim
     }
 }
 
-/// Robust standard deviation `1.4826 median |v|` of a zero-mean plane over the valid pixels
+/// Robust standard deviation `MAD_TO_SIGMA · median |v|` of a zero-mean plane over the valid pixels
 /// (0 without any).
 fn robust_sigma(v: &Gray<f32>, valid: &[bool]) -> f32 {
     let abs = v
@@ -174,5 +174,5 @@ fn robust_sigma(v: &Gray<f32>, valid: &[bool]) -> f32 {
         .zip(valid)
         .filter(|(_, ok)| **ok)
         .map(|(x, _)| x.abs());
-    1.4826 * polar_image::quantile(abs, 0.5).unwrap_or(0.0)
+    crate::refine::MAD_TO_SIGMA * polar_image::quantile(abs, 0.5).unwrap_or(0.0)
 }

@@ -115,6 +115,9 @@ pub fn noise_sigma(input: &Normalized) -> f32 {
     plane_noise(&input.s0, &input.valid, 1)
 }
 
+/// Standard deviation over median absolute deviation for Gaussian noise (`1 / Φ⁻¹(3/4)`).
+pub const MAD_TO_SIGMA: f32 = 1.4826;
+
 /// [`noise_sigma`] of any plane over the pixels of `valid`, from every `row_step`-th row.
 pub fn plane_noise(plane: &Gray<f32>, valid: &[bool], row_step: usize) -> f32 {
     let (w, h) = plane.size();
@@ -127,7 +130,8 @@ pub fn plane_noise(plane: &Gray<f32>, valid: &[bool], row_step: usize) -> f32 {
         .step_by(row_step.max(1))
         .map(|y| row_responses(s0, valid, w, y))
         .collect();
-    polar_image::quantile(rows.iter().flatten().copied(), 0.5).map_or(0.0, |med| 1.4826 * med / 6.0)
+    polar_image::quantile(rows.iter().flatten().copied(), 0.5)
+        .map_or(0.0, |med| MAD_TO_SIGMA * med / 6.0)
 }
 
 /// `|[1 -2 1] x [1 -2 1]|` responses of row `y` (`1 <= y < h - 1`) at the pixels whose 3x3
