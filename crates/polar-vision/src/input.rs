@@ -18,6 +18,7 @@ use polar_sensor::{
     ColorStokesPlanes, DemosaicMethod, MosaicPattern, Observation, StokesPlanes, stokes_planes,
     stokes_planes_rgb,
 };
+use rayon::prelude::*;
 use serde_json::{Map, Value};
 
 use crate::error::CliError;
@@ -399,11 +400,69 @@ fn check_exposure(
             100.0 * saturated as f64 / n as f64
         )
     });
+    let stats = ExposureStats::of(raw);
     Ok(saturation
         .into_iter()
-        .chain(dim_warning(path, raw))
-        .chain(dark_channel_warning(path, raw))
+        .chain(dim_warning(path, &stats))
+        .chain(dark_channel_warning(path, &stats))
         .collect())
+}
+
+/// What the dim and dark-channel warnings read of a raw frame, in one pass.
+#[derive(Clone, Debug, PartialEq)]
+struct ExposureStats {
+    /// Sums of the four super-pixel positions (row-major within the 2×2 block).
+    channel_sums: [f64; 4],
+    /// Pixels per channel.
+    channel_count: [usize; 4],
+    /// Pixels at each level below [`DIM_LEVEL_DN`].
+    dim_levels: [usize; DIM_LEVEL_DN as usize],
+    /// All pixels.
+    pixels: usize,
+}
+
+impl ExposureStats {
+    fn of(raw: &Mosaic<u16>) -> Self {
+        let w = raw.size().0.max(1);
+        let empty = || Self {
+            channel_sums: [0.0; 4],
+            channel_count: [0; 4],
+            dim_levels: [0; DIM_LEVEL_DN as usize],
+            pixels: 0,
+        };
+        raw.as_slice()
+            .par_chunks(w)
+            .enumerate()
+            .fold(empty, |mut s, (y, row)| {
+                let mut sums = [0u64; 2];
+                for pair in row.chunks(2) {
+                    for (c, &v) in pair.iter().enumerate() {
+                        sums[c] += u64::from(v);
+                        if v < DIM_LEVEL_DN {
+                            s.dim_levels[usize::from(v)] += 1;
+                        }
+                    }
+                }
+                for (c, sum) in sums.into_iter().enumerate() {
+                    s.channel_sums[(y % 2) * 2 + c] += sum as f64;
+                    s.channel_count[(y % 2) * 2 + c] += (row.len() + 1 - c) / 2;
+                }
+                s.pixels += row.len();
+                s
+            })
+            .reduce(empty, |mut a, b| {
+                (0..4).for_each(|c| {
+                    a.channel_sums[c] += b.channel_sums[c];
+                    a.channel_count[c] += b.channel_count[c];
+                });
+                a.dim_levels
+                    .iter_mut()
+                    .zip(b.dim_levels)
+                    .for_each(|(x, y)| *x += y);
+                a.pixels += b.pixels;
+                a
+            })
+    }
 }
 
 /// A polarizer channel (one position of the 2×2 super-pixel, in mono and colour layouts
@@ -414,14 +473,9 @@ pub const DARK_CHANNEL_SHARE: f64 = 0.1;
 
 /// A warning when one polarizer channel is far darker than the others
 /// ([`DARK_CHANNEL_SHARE`]).
-fn dark_channel_warning(path: &Path, raw: &Mosaic<u16>) -> Option<String> {
-    let (w, h) = raw.size();
-    let mut sums = [0.0f64; 4];
-    for (k, &v) in raw.as_slice().iter().enumerate() {
-        sums[(k / w % 2) * 2 + k % w % 2] += f64::from(v);
-    }
-    let count = (w * h / 4).max(1) as f64;
-    let means = sums.map(|s| s / count);
+fn dark_channel_warning(path: &Path, stats: &ExposureStats) -> Option<String> {
+    let means: [f64; 4] =
+        std::array::from_fn(|c| stats.channel_sums[c] / stats.channel_count[c].max(1) as f64);
     let brightest = means.iter().copied().fold(0.0, f64::max);
     let (dark, mean) = means
         .iter()
@@ -453,15 +507,11 @@ pub const DIM_LEVEL_DN: u16 = 16;
 pub const ROUNDING_DOLP: f64 = 0.2558;
 
 /// A warning when nine pixels in ten are below [`DIM_LEVEL_DN`].
-fn dim_warning(path: &Path, raw: &Mosaic<u16>) -> Option<String> {
-    let mut histogram = vec![0usize; usize::from(DIM_LEVEL_DN)];
-    for &v in raw.as_slice().iter().filter(|&&v| v < DIM_LEVEL_DN) {
-        histogram[usize::from(v)] += 1;
-    }
-    let n = raw.as_slice().len();
+fn dim_warning(path: &Path, stats: &ExposureStats) -> Option<String> {
+    let n = stats.pixels;
     // The smallest level at or below which nine pixels in ten lie, if below the limit.
     let mut below = 0;
-    let p90 = histogram.iter().position(|&c| {
+    let p90 = stats.dim_levels.iter().position(|&c| {
         below += c;
         10 * below >= 9 * n
     })?;
@@ -489,14 +539,18 @@ mod tests {
                 .collect();
             Mosaic::from_vec(10, 10, v).unwrap()
         };
-        let warning = dim_warning(path, &frame(90, 200)).expect("nine in ten at 3 DN");
+        let warning =
+            dim_warning(path, &ExposureStats::of(&frame(90, 200))).expect("nine in ten at 3 DN");
         assert!(warning.contains("at 3 DN or below"), "{warning}");
         assert!(warning.contains("about 0.09"), "{warning}");
         // A dark background under a tenth of well-exposed pixels is no dim frame...
-        assert_eq!(dim_warning(path, &frame(89, 200)), None);
+        assert_eq!(dim_warning(path, &ExposureStats::of(&frame(89, 200))), None);
         // ...nor is a frame at the limit, while one a DN below it is.
-        assert_eq!(dim_warning(path, &frame(0, DIM_LEVEL_DN)), None);
-        assert!(dim_warning(path, &frame(0, DIM_LEVEL_DN - 1)).is_some());
+        assert_eq!(
+            dim_warning(path, &ExposureStats::of(&frame(0, DIM_LEVEL_DN))),
+            None
+        );
+        assert!(dim_warning(path, &ExposureStats::of(&frame(0, DIM_LEVEL_DN - 1))).is_some());
         let warnings = check_exposure(path, &frame(95, 4095), 12, 4095).unwrap();
         for what in ["saturated", "nine pixels in ten"] {
             assert!(
@@ -522,11 +576,15 @@ mod tests {
                 .collect();
             Mosaic::from_vec(8, 8, v).unwrap()
         };
-        let warning = dark_channel_warning(path, &frame(1, 0)).expect("a dead channel");
+        let warning =
+            dark_channel_warning(path, &ExposureStats::of(&frame(1, 0))).expect("a dead channel");
         assert!(warning.contains("row 1, column 1"), "{warning}");
-        assert!(dark_channel_warning(path, &frame(0, 90)).is_some());
+        assert!(dark_channel_warning(path, &ExposureStats::of(&frame(0, 90))).is_some());
         // A DoLP of 0.8 over the whole frame: the darkest channel at 0.11 of the brightest.
-        assert_eq!(dark_channel_warning(path, &frame(0, 111)), None);
+        assert_eq!(
+            dark_channel_warning(path, &ExposureStats::of(&frame(0, 111))),
+            None
+        );
     }
 
     #[test]
