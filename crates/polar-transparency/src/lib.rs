@@ -9,10 +9,11 @@
 //! the locally averaged Stokes vector, its coherence (that DoLP over the mean per-pixel
 //! DoLP: sensor noise and demosaicing artefacts at texture edges have random AoLP and
 //! average out); it then thresholds the score ([`cue_threshold`]: Otsu's, bounded by the
-//! background's level and by the noise's; or a given threshold), closes and opens the
-//! mask, fills holes (background components not touching the border), drops specks,
-//! replaces each component by its convex hull and trims the depolarized rim that the
-//! window added around it, all with polar-imgproc. The hull is there because glass is
+//! background's level and by the noise's; or a given threshold), lets the seeds along the
+//! frame's edge follow their neighbours inside ([`BORDER`]), closes and opens the mask,
+//! fills holes (background components not touching the border), drops specks, replaces
+//! each component by its convex hull and trims the depolarized rim that the window added
+//! around it, all with polar-imgproc. The hull is there because glass is
 //! polarized mostly along its rims and edges (reflection and transmission both grow toward
 //! grazing) and little where it faces the camera, so the seeds are open arcs around the
 //! object; glass objects (balls, slabs, cups, bottles) are mostly convex.
@@ -241,6 +242,7 @@ pub fn detect(
             (p, t, seed)
         }
     };
+    let seed = border_from_inside(seed, w, h);
     let m = polar_imgproc::mask::clean(&seed, w, h)?;
     let m = polar_imgproc::mask::remove_small(&m, w, h, MIN_WINDOWS * cues::WINDOW.pow(2))?;
     let m = polar_imgproc::mask::convex_hull_objects(&m, w, h)?;
@@ -254,6 +256,29 @@ pub fn detect(
         threshold,
         noise_floor: bar.noise_floor.then_some(bar.value),
     })
+}
+
+/// Seeds this close to the frame's edge (pixels) are not judged by their own cues but
+/// take the nearest judged pixel's verdict: there the median and the averaging window
+/// ([`cues::MEDIAN`], [`cues::WINDOW`]), with the demosaicing's interpolation one pixel
+/// further, reach past the edge and see its mirror image, so
+/// the demosaicing's false polarization along an intensity edge near the border (the
+/// polarizers of a super-pixel sample either side of it) is repeated instead of cancelled
+/// by the edge's other side, and reads as coherent.
+pub const BORDER: usize = cues::MEDIAN / 2 + cues::WINDOW / 2 + 1;
+
+/// `seed` with each pixel within [`BORDER`] of the frame's edge set as the nearest pixel
+/// beyond that band: an object (or a surface filling the view) reaching the band reaches
+/// the edge, a border's false polarization is dropped.
+fn border_from_inside(seed: Vec<bool>, w: usize, h: usize) -> Vec<bool> {
+    if w <= 2 * BORDER || h <= 2 * BORDER {
+        return seed;
+    }
+    let inner = |k: usize| {
+        let (x, y) = (k % w, k / w);
+        x.clamp(BORDER, w - 1 - BORDER) + y.clamp(BORDER, h - 1 - BORDER) * w
+    };
+    (0..w * h).map(|k| seed[inner(k)]).collect()
 }
 
 /// `mask` without the components whose median S0 is below [`SEE_THROUGH`] times the
