@@ -60,8 +60,9 @@
 //! cancel along stretches of the rim, and the shape prior checks it per boundary pixel
 //! instead (`crate::local`). Last, the gaps between a component and its convex hull that
 //! the component mostly borders and that are as bright as it are filled
-//! (`fill_hull_gaps`): a white object on a light floor is found as the open arcs of its
-//! rim, its face toward the camera too weakly polarized and edged for either cue. Then
+//! (`fill_hull_gaps`; two large blobs joined by a narrow neck are hulled apart): a white
+//! object on a light floor is found as the open arcs of its rim, its face toward the
+//! camera too weakly polarized and edged for either cue. Then
 //! the boundary pixels as bright as the background beside them rather than the object
 //! are given back to the background, twice (`trim_boundary`): the edges of A straddle
 //! the silhouette.
@@ -77,10 +78,10 @@ use std::collections::VecDeque;
 use std::ops::RangeInclusive;
 
 use polar_image::{Gray, quantile};
-use polar_imgproc::mask::{components, fill_holes, remove_small};
+use polar_imgproc::mask::{components, fill_holes, remove_small, split_at_necks};
 use polar_imgproc::{
-    Border, MorphShape, dilate, erode, gaussian_blur, gaussian_kernel, open, sep_filter, sobel,
-    threshold_otsu,
+    Border, MorphShape, Outside, dilate, distance_to_background, erode, gaussian_blur,
+    gaussian_kernel, open, sep_filter, sobel, threshold_otsu,
 };
 
 use rayon::prelude::*;
@@ -152,6 +153,13 @@ const MIN_BACKGROUND_DOLP: f32 = 0.01;
 const COHERENT_DOLP_FACTOR: f32 = 1.2;
 /// The quantile of the DoLP that [`COHERENT_DOLP_FACTOR`] compares.
 const DOLP_QUANTILE: f64 = 0.75;
+/// Two objects whose regions touch through a bridge narrower than this share of the
+/// smaller one's inscribed radius (a shared shadow, a strip of floor) get a convex hull
+/// each in [`fill_hull_gaps`]: the floor seen between them is a gap of neither.
+const HULL_NECK: f32 = 0.3;
+/// ... where both inscribed radii reach this share of the image's shorter side: the
+/// thinner arcs of one object's rim stay together, and their hull is its face.
+const HULL_BLOB: f32 = 0.05;
 /// Passes of [`trim_boundary`] (each peels at most one pixel).
 const TRIM_PASSES: usize = 2;
 /// Half-width (pixels) of the window [`trim_boundary`] compares a boundary pixel in.
@@ -442,7 +450,7 @@ fn with_evidence(
 /// its rim, as bright as the rim, rather than the floor seen between two objects.
 pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
-    let hull = polar_imgproc::mask::convex_hull_objects(&fg, w, h)?;
+    let hull = hull_per_blob(&fg, w, h)?;
     let gaps: Vec<bool> = (0..w * h)
         .map(|k| hull[k] && !fg[k] && cues.valid[k])
         .collect();
@@ -479,6 +487,27 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
         })
         .collect();
     Ok((0..w * h).map(|k| fg[k] || fill[id[k] as usize]).collect())
+}
+
+/// The union of the convex hulls of `fg`'s blobs: its components cut at narrow necks
+/// ([`HULL_NECK`], [`HULL_BLOB`]), the pixels where two blobs meet left out.
+fn hull_per_blob(fg: &[bool], w: usize, h: usize) -> Result<Vec<bool>, ShapeError> {
+    let dist: Vec<f32> = distance_to_background(fg, w, h, Outside::NotBackground)
+        .into_iter()
+        .map(|d| d as f32)
+        .collect();
+    let min_peak = HULL_BLOB * w.min(h) as f32;
+    let (blob, _) = split_at_necks(fg, &dist, w, h, HULL_NECK, min_peak)?;
+    let apart: Vec<bool> = (0..w * h)
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            let alone = |a: usize, b: usize| [0, blob[k]].contains(&blob[b * w + a]);
+            blob[k] != 0
+                && (y.saturating_sub(1)..=(y + 1).min(h - 1))
+                    .all(|b| (x.saturating_sub(1)..=(x + 1).min(w - 1)).all(|a| alone(a, b)))
+        })
+        .collect();
+    Ok(polar_imgproc::mask::convex_hull_objects(&apart, w, h)?)
 }
 
 /// `fg` without the boundary pixels (those with a 4-neighbour outside `fg`) whose log

@@ -1183,6 +1183,40 @@ fn face_between_rim_arcs_is_filled_floor_is_not() {
     }
 }
 
+/// Two boxes whose regions a thin bar joins along their bottoms (a shared shadow, a strip
+/// of floor) enclose the floor between them on three sides, nearer their brightness than
+/// the floor around: it is no face of either, so it stays out (one hull over both fills
+/// it).
+#[test]
+fn floor_between_two_joined_objects_is_not_filled() {
+    let (w, h) = (96, 64);
+    let fg: Vec<bool> = (0..w * h)
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            let boxes = (8..40).contains(&y) && ((16..40).contains(&x) || (56..80).contains(&x));
+            boxes || ((16..80).contains(&x) && (37..40).contains(&y))
+        })
+        .collect();
+    // Objects 0.8, the floor 0.2, but 0.6 between the objects (light they reflect onto it).
+    let s0: Vec<f32> = (0..w * h)
+        .map(|k| match (fg[k], (40..56).contains(&(k % w))) {
+            (true, _) => 0.8,
+            (false, true) => 0.6,
+            (false, false) => 0.2,
+        })
+        .collect();
+    let obs = uniform_observation(w, h, [1.0, 0.0, 0.0], CameraModel::Orthographic);
+    let mut planes = obs.planes.clone();
+    planes.s0.as_mut_slice().copy_from_slice(&s0);
+    let cues = Cues::new(&Observation::new(planes, CameraModel::Orthographic), 1.5).unwrap();
+    let out = crate::foreground::fill_hull_gaps(&cues, fg.clone()).unwrap();
+    let added = (0..w * h).filter(|&k| out[k] && !fg[k]).count();
+    assert!(
+        !out[24 * w + 48],
+        "the floor between the boxes was filled ({added} pixels)"
+    );
+}
+
 /// A disc on a floor, its mask grown by one pixel into the floor (as cue A's edges leave
 /// it): one pass of the boundary trim gives the floor pixels back, brighter or darker
 /// than the disc, and keeps every pixel of the disc.
