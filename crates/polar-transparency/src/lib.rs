@@ -261,10 +261,10 @@ pub fn detect(
 /// Seeds this close to the frame's edge (pixels) are not judged by their own cues but
 /// take the nearest judged pixel's verdict: there the median and the averaging window
 /// ([`cues::MEDIAN`], [`cues::WINDOW`]), with the demosaicing's interpolation one pixel
-/// further, reach past the edge and see its mirror image, so
-/// the demosaicing's false polarization along an intensity edge near the border (the
-/// polarizers of a super-pixel sample either side of it) is repeated instead of cancelled
-/// by the edge's other side, and reads as coherent.
+/// further, reach past the edge and see its mirror image, so the demosaicing's false
+/// polarization along an intensity edge near the border (the polarizers of a super-pixel
+/// sample either side of it) is repeated instead of cancelled by the edge's other side,
+/// and reads as coherent.
 pub const BORDER: usize = cues::MEDIAN / 2 + cues::WINDOW / 2 + 1;
 
 /// `seed` with each pixel within [`BORDER`] of the frame's edge set as the nearest pixel

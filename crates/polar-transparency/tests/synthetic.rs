@@ -293,7 +293,7 @@ fn unpolarized_checkerboard_has_no_glass() {
 /// but along the frame's edge it sees the mirror image. An unpolarized checkerboard whose
 /// edges run two pixels inside the top and right borders (one row of half tone between
 /// the squares along the top), mosaicked and demosaicked by the default method and
-/// bilinear, has no glass (without the border rule bilinear's marks 298 pixels). Not
+/// bilinear, has no glass (without the border rule, 298 pixels of bilinear's). Not
 /// `newton`: its false polarization at such a soft edge is coherent anywhere in the frame.
 #[test]
 fn demosaicked_edges_along_the_border_are_no_glass() {
