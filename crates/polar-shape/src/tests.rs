@@ -1217,6 +1217,18 @@ fn floor_between_two_joined_objects_is_not_filled() {
     );
 }
 
+/// A foreground covering the whole frame (one surface filling the view) has no gap and no
+/// neck: the hull gaps leave it as it is (the distance to a background it lacks is
+/// infinite, which the neck splitter refuses).
+#[test]
+fn foreground_filling_the_frame_keeps_its_hull_gaps_empty() {
+    let (w, h) = (32, 24);
+    let obs = uniform_observation(w, h, [1.0, 0.1, 0.0], CameraModel::Orthographic);
+    let cues = Cues::new(&obs, 1.5).unwrap();
+    let out = crate::foreground::fill_hull_gaps(&cues, vec![true; w * h]).unwrap();
+    assert!(out.iter().all(|&v| v));
+}
+
 /// A disc on a floor, its mask grown by one pixel into the floor (as cue A's edges leave
 /// it): one pass of the boundary trim gives the floor pixels back, brighter or darker
 /// than the disc, and keeps every pixel of the disc.
