@@ -490,13 +490,10 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
 }
 
 /// The union of the convex hulls of `fg`'s blobs: its components cut at narrow necks
-/// ([`HULL_NECK`], [`HULL_BLOB`]), the pixels where two blobs meet left out. A foreground
-/// filling the frame is its own hull (no background to measure necks against).
+/// ([`HULL_NECK`], [`HULL_BLOB`]; inscribed radii as the material rule's, the frame's
+/// edge counting as background), the pixels where two blobs meet left out.
 fn hull_per_blob(fg: &[bool], w: usize, h: usize) -> Result<Vec<bool>, ShapeError> {
-    if fg.iter().all(|&f| f) {
-        return Ok(fg.to_vec());
-    }
-    let dist: Vec<f32> = distance_to_background(fg, w, h, Outside::NotBackground)
+    let dist: Vec<f32> = distance_to_background(fg, w, h, Outside::Background)
         .into_iter()
         .map(|d| d as f32)
         .collect();

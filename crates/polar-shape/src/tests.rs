@@ -1218,8 +1218,8 @@ fn floor_between_two_joined_objects_is_not_filled() {
 }
 
 /// A foreground covering the whole frame (one surface filling the view) has no gap and no
-/// neck: the hull gaps leave it as it is (the distance to a background it lacks is
-/// infinite, which the neck splitter refuses).
+/// neck: the hull gaps leave it as it is, without an error (inside the frame alone the
+/// distance to a background it lacks would be infinite, which the neck splitter refuses).
 #[test]
 fn foreground_filling_the_frame_keeps_its_hull_gaps_empty() {
     let (w, h) = (32, 24);
