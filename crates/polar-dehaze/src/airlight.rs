@@ -24,7 +24,8 @@
 //! 4. **`p` and `A_inf` over the frame** (`varying_airlight`, [`SkyField`]). Neither is
 //!    one number: `p` follows the scattering angle, and the sky is brighter towards the
 //!    sun. Blocks with `P / S0 >= SKY_LEVEL p` and `P / p >= SKY_LEVEL A_inf` are sky
-//!    candidates; an upper-envelope plane of their `P / S0` picks those at infinity; a
+//!    candidates; an upper-envelope plane of their `P / S0`, fitted inside extended
+//!    regions of them (a strongly polarized highlight is no sky), picks those at infinity; a
 //!    plane fitted to them gives `p(x, y)`, and the upper-envelope plane of the airlight
 //!    of those inside extended regions of candidates and near the sky's brightness gives
 //!    `A_inf(x, y)` (both clamped to the range seen). Needs [`MIN_SKY_BLOCKS`] of them;
@@ -43,6 +44,12 @@
 //! - `A_inf` is a plane: a sky that varies more than a plane (a bright band around the
 //!   sun) is dehazed as a bright object where it rises above the plane; the plane's
 //!   extrapolation below the horizon is the sky's, not the airlight's towards the ground;
+//! - sky whose `p` falls below [`SKY_LEVEL`] of the frame's envelope (towards the sun, where
+//!   scattering polarizes least) is no candidate, and the plane of `p`, clamped to the
+//!   range seen, stays too high there: `t` too high, the sky there left hazy;
+//! - sensor or Monte Carlo noise comparable to `p` in a block's `P / S0` (weak airlight
+//!   polarization on a small image) raises both envelopes: `p` and `A_inf` too high, `t`
+//!   too high where the airlight is weak;
 //! - no sky region large enough for [`MIN_SKY_BLOCKS`] interior blocks: one `p` and
 //!   `A_inf` (a sky much brighter on one side then leaves `t > 0` on the darker side);
 //! - airlight polarization at the noise level: `p` is then noise; [`crate::polarization`]
@@ -408,7 +415,8 @@ pub const MIN_SKY_BLOCKS: usize = 12;
 pub const ENVELOPE_EXPECTILE: f64 = 0.99;
 /// Reweighting passes of the expectile fit.
 const EXPECTILE_PASSES: usize = 10;
-/// Candidates whose `P` is within this fraction below the envelope are at infinity.
+/// Candidates whose `P / S0` is within this fraction of the envelope, either side, are at
+/// infinity.
 pub const INFINITY_TOLERANCE: f64 = 0.1;
 /// Blocks at infinity whose airlight is below this share of the brightest sky's are not
 /// sky (`bright_inner`); a sky brighter towards the sun keeps its dimmer side down to
@@ -437,10 +445,13 @@ pub struct SkyField {
 
 impl SkyField {
     /// Fits the planes. `P / S0 <= p` everywhere, with equality only where no direct light
-    /// arrives, so the candidates (which include hazy but finite distances) first get an
-    /// upper-envelope plane of `P / S0` ([`envelope_plane`]); the blocks within
-    /// [`INFINITY_TOLERANCE`] of it are taken as infinity, and the plane of `p` is refitted
-    /// to them by least squares. The airlight `A = P / p(x, y)` is at most `A_inf`, with
+    /// arrives, so the candidates (which include hazy but finite distances) get an
+    /// upper-envelope plane of `P / S0` ([`envelope_plane`]), fitted to those inside
+    /// extended regions of them ([`interior`]): a polarized highlight on a glossy object,
+    /// aligned with the airlight and stronger than it, is too small to hold a block there
+    /// and would pull the envelope up. The candidates within [`INFINITY_TOLERANCE`] of the
+    /// envelope, either side, are taken as infinity, and the plane of `p` is refitted to
+    /// them by least squares. The airlight `A = P / p(x, y)` is at most `A_inf`, with
     /// equality at infinity, so `A_inf` is the upper-envelope plane of `A` over those
     /// blocks inside extended regions of candidates and bright enough ([`bright_inner`]),
     /// and in the top cluster of `A` ([`upper_blocks`]): a black object also has
@@ -449,11 +460,11 @@ impl SkyField {
     fn fit(blocks: &Blocks, proj: &[f32], candidates: &[usize]) -> Option<Self> {
         let eval = |c: &[f64; 3], i: usize| c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i];
         let dolp = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
-        let env = envelope_plane(blocks, candidates, &dolp)?;
+        let env = envelope_plane(blocks, &interior(blocks, candidates), &dolp)?;
         let inf: Vec<usize> = candidates
             .iter()
             .copied()
-            .filter(|&i| dolp(i) >= (1.0 - INFINITY_TOLERANCE) * eval(&env, i))
+            .filter(|&i| (dolp(i) - eval(&env, i)).abs() <= INFINITY_TOLERANCE * eval(&env, i))
             .collect();
         if inf.len() < MIN_SKY_BLOCKS {
             return None;
