@@ -460,11 +460,15 @@ impl SkyField {
     fn fit(blocks: &Blocks, proj: &[f32], candidates: &[usize]) -> Option<Self> {
         let eval = |c: &[f64; 3], i: usize| c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i];
         let dolp = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
-        let env = envelope_plane(blocks, &interior(blocks, candidates), &dolp)?;
+        let inner = interior(blocks, candidates);
+        let env = envelope_plane(blocks, &inner, &dolp)?;
         let inf: Vec<usize> = candidates
             .iter()
             .copied()
-            .filter(|&i| (dolp(i) - eval(&env, i)).abs() <= INFINITY_TOLERANCE * eval(&env, i))
+            .filter(|&i| {
+                let e = eval(&env, i);
+                (dolp(i) - e).abs() <= INFINITY_TOLERANCE * e
+            })
             .collect();
         if inf.len() < MIN_SKY_BLOCKS {
             return None;
@@ -481,11 +485,7 @@ impl SkyField {
             f64::from(proj[i]) / plane(&dolp_plane, dolp_range, blocks.x[i], blocks.y[i])
         };
         // Black objects pass the `p` test at any distance, but their airlight is below A_inf.
-        let top = upper_blocks(
-            blocks,
-            &bright_inner(blocks, candidates, &inf, &airlight)?,
-            &airlight,
-        )?;
+        let top = upper_blocks(blocks, &bright_inner(&inner, &inf, &airlight)?, &airlight)?;
         Some(Self {
             dolp: dolp_plane,
             dolp_range,
@@ -540,31 +540,26 @@ fn envelope_plane(blocks: &Blocks, idx: &[usize], v: &dyn Fn(usize) -> f64) -> O
     Some(env)
 }
 
-/// The blocks at infinity (`inf`) inside extended regions of the sky candidates
-/// ([`interior`]) whose airlight `v` is at least [`SKY_AIRLIGHT_SHARE`] of the
+/// The blocks at infinity (`inf`) inside extended regions of the sky candidates (`inner`,
+/// their [`interior`]) whose airlight `v` is at least [`SKY_AIRLIGHT_SHARE`] of the
 /// [`AIRLIGHT_QUANTILE`] of theirs. The regions are the candidates', not those of `inf`:
 /// where noise is comparable to the spread of `P / S0` over the sky, it picks which sky
 /// blocks reach the envelope, scattered, and few of them have all four neighbours among
 /// them. Black objects and hazy ground inside the candidates' regions also reach it, at
 /// any distance; their airlight `A_inf (1 - t)` falls short of the sky's.
-fn bright_inner(
-    blocks: &Blocks,
-    candidates: &[usize],
-    inf: &[usize],
-    v: &dyn Fn(usize) -> f64,
-) -> Option<Vec<usize>> {
-    let extended: HashSet<usize> = interior(blocks, candidates).into_iter().collect();
-    let inner: Vec<usize> = inf
+fn bright_inner(inner: &[usize], inf: &[usize], v: &dyn Fn(usize) -> f64) -> Option<Vec<usize>> {
+    let extended: HashSet<usize> = inner.iter().copied().collect();
+    let inside: Vec<usize> = inf
         .iter()
         .copied()
         .filter(|i| extended.contains(i))
         .collect();
     let top = f64::from(quantile(
-        inner.iter().map(|&i| v(i) as f32),
+        inside.iter().map(|&i| v(i) as f32),
         AIRLIGHT_QUANTILE,
     )?);
     Some(
-        inner
+        inside
             .into_iter()
             .filter(|&i| v(i) >= SKY_AIRLIGHT_SHARE * top)
             .collect(),
