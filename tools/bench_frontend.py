@@ -24,7 +24,9 @@ runs it (release build), median of N runs, with the default `residual` and with
 `--demosaic bilinear`, in the same run as polanalyser's chain; reports the split the
 program prints (compute = read + demosaic + products, outputs) and its `--timings` stages
 (read, exposure checks, demosaic + products, validity mask, each output file), the bytes its
-outputs take on disk and its peak resident memory per input pixel (from GNU time).
+outputs take on disk and its peak resident memory per input pixel (from GNU time); and a
+floor row: the same number of bytes written as seven files into a fresh folder on the same
+file system from this process, with no compute and no encoding.
 
 Usage: tools/.venv/bin/python tools/bench_frontend.py [FRAME.png] [--reps N] [--process N] [--no-native]
 """
@@ -100,6 +102,18 @@ def run_process(exe, frame, extra):
     return wall, split.groups() if split else ("?", "?"), size, peak, stages.group(1) if stages else "?"
 
 
+def write_floor(size, files=7):
+    """Seconds to write `size` bytes as `files` files into a fresh folder on the same file
+    system as the process runs' outputs (page cache, no sync, as `stokes` writes them): the
+    least any process with these outputs takes, however fast its compute and encoding."""
+    chunk = os.urandom(size // files)
+    with tempfile.TemporaryDirectory() as tmp:
+        t = time.perf_counter()
+        for i in range(files):
+            (Path(tmp) / f"out{i}").write_bytes(chunk)
+        return time.perf_counter() - t
+
+
 def process_table(frame, runs, t_py, pixels):
     target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
     subprocess.run(["cargo", "build", "--release", "--locked", "-p", "polar-vision"], cwd=ROOT, check=True, stderr=subprocess.DEVNULL)
@@ -108,7 +122,7 @@ def process_table(frame, runs, t_py, pixels):
     print(f"Whole process, median of {runs} runs (polanalyser compute {t_py * 1e3:.0f} ms in this run):")
     print(f"| {'command':<44} | {'wall ms':>8} | {'vs polanalyser':>14} | {'compute / outputs ms':>20} | {'MB on disk':>10} | {'peak B/px':>9} |")
     print(f"|{'-' * 46}|{'-' * 10}|{'-' * 16}|{'-' * 22}|{'-' * 12}|{'-' * 11}|")
-    splits = []
+    splits, sizes = [], []
     for label, extra in [("stokes (default: residual)", []), ("stokes --demosaic bilinear", ["--demosaic", "bilinear"])]:
         rs = [run_process(exe, frame, extra) for _ in range(runs)]
         wall = statistics.median(r[0] for r in rs)
@@ -120,6 +134,12 @@ def process_table(frame, runs, t_py, pixels):
             f"{mid[2] / 1e6:10.1f} | {peak} |"
         )
         splits.append((label, mid[4]))
+        sizes.append(mid[2])
+    floor = statistics.median(write_floor(max(sizes)) for _ in range(runs))
+    print(
+        f"| {'floor: the same bytes written, no compute':<44} | {floor * 1e3:8.0f} | {t_py / floor:13.2f}x | "
+        f"{'-':>20} | {max(sizes) / 1e6:10.1f} | {'-':>9} |"
+    )
     print()
     print("Stages of the median run (--timings; output files are encoded in parallel, so their times overlap):")
     for label, stages in splits:
