@@ -15,3 +15,4 @@ pub mod task_options;
 pub mod tasks;
 pub mod timings;
 pub mod train;
+pub mod writes;

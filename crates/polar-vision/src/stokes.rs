@@ -12,12 +12,12 @@ use polar_io::{
 };
 use polar_sensor::picture::{aolp_hsv_into, colormap_into, srgb_into};
 use polar_sensor::{ColorStokesPlanes, StokesPlanes};
-use rayon::prelude::*;
 
 use crate::error::CliError;
 use crate::input::{InputArgs, InputFile, read_input, resolve};
 use crate::out_dir;
 use crate::timings::Timings;
+use crate::writes::Writes;
 
 /// Arguments of `polar-vision stokes`.
 #[derive(Debug, Args)]
@@ -126,18 +126,6 @@ impl Output {
 }
 
 /// One output file's encoding: the file's name and the work.
-type Job<'a> = (
-    &'static str,
-    Box<dyn FnOnce() -> Result<(), polar_io::Error> + Send + 'a>,
-);
-
-fn job<'a>(
-    name: &'static str,
-    work: impl FnOnce() -> Result<(), polar_io::Error> + Send + 'a,
-) -> Job<'a> {
-    (name, Box::new(work))
-}
-
 /// What the outputs show: the Stokes planes (of the luminance for a colour mosaic) and,
 /// for a colour mosaic, each colour's planes.
 #[derive(Clone, Copy, Debug)]
@@ -162,9 +150,9 @@ pub fn write_outputs(
     let want = |o: Output| outputs.contains(&o);
     let planes = what.planes;
     let raw = ExrCompression::None;
-    let mut jobs: Vec<Job<'_>> = Vec::new();
+    let mut jobs = Writes::default();
     if want(Output::Stokes) {
-        jobs.push(job(vision::STOKES, move || {
+        jobs.push(vision::STOKES, move || {
             let path = out.join(vision::STOKES);
             match what.colors {
                 Some(c) => {
@@ -178,7 +166,7 @@ pub fn write_outputs(
                     polar_io::write_exr_planes3(path, s, LINEAR_STOKES_CHANNELS, raw)
                 }
             }
-        }));
+        });
     }
     type Pick = fn(&StokesPlanes) -> &Gray<f32>;
     let derived: [(Output, &'static str, Pick); 2] = [
@@ -186,7 +174,7 @@ pub fn write_outputs(
         (Output::Aolp, vision::AOLP, |p| &p.aolp),
     ];
     for (_, name, pick) in derived.into_iter().filter(|d| want(d.0)) {
-        jobs.push(job(name, move || {
+        jobs.push(name, move || {
             let path = out.join(name);
             match what.colors {
                 Some(c) => {
@@ -202,33 +190,24 @@ pub fn write_outputs(
                 }
                 None => polar_io::write_exr_plane(path, pick(planes), Y_CHANNEL[0], raw),
             }
-        }));
+        });
     }
     if want(Output::Pictures) {
         push_pictures(&mut jobs, out, what);
     }
     if let Some(mask) = mask.filter(|_| want(Output::Mask)) {
-        jobs.push(job(vision::MASK, move || {
+        jobs.push(vision::MASK, move || {
             polar_io::write_gray8_png(out.join(vision::MASK), mask)
-        }));
+        });
     }
-    let took = jobs
-        .into_par_iter()
-        .map(|(name, work)| {
-            let start = Instant::now();
-            work().map(|()| (name, start.elapsed()))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut timings = Timings::default();
-    took.into_iter().for_each(|(name, t)| timings.push(name, t));
-    Ok(timings)
+    Ok(jobs.run()?)
 }
 
 /// The jobs of aolp.png, dolp.png (of `what.planes`) and s0.png (in colour for a colour mosaic).
-fn push_pictures<'a>(jobs: &mut Vec<Job<'a>>, out: &'a Path, what: Planes<'a>) {
+fn push_pictures<'a>(jobs: &mut Writes<'a>, out: &'a Path, what: Planes<'a>) {
     let planes = what.planes;
     let size = planes.s0.size();
-    jobs.push(job(vision::AOLP_PICTURE, move || {
+    jobs.push(vision::AOLP_PICTURE, move || {
         polar_io::write_rgb8_png_rows(out.join(vision::AOLP_PICTURE), size, |y, bytes| {
             let (px, k) = pixel_rows(size.0, y, bytes);
             aolp_hsv_into(
@@ -237,14 +216,14 @@ fn push_pictures<'a>(jobs: &mut Vec<Job<'a>>, out: &'a Path, what: Planes<'a>) {
                 px,
             );
         })
-    }));
-    jobs.push(job(vision::DOLP_PICTURE, move || {
+    });
+    jobs.push(vision::DOLP_PICTURE, move || {
         polar_io::write_rgb8_png_rows(out.join(vision::DOLP_PICTURE), size, |y, bytes| {
             let (px, k) = pixel_rows(size.0, y, bytes);
             colormap_into(&planes.dolp.as_slice()[k], 0.0, 1.0, px);
         })
-    }));
-    jobs.push(job(vision::S0_PICTURE, move || {
+    });
+    jobs.push(vision::S0_PICTURE, move || {
         let path = out.join(vision::S0_PICTURE);
         match what.colors {
             Some(c) => {
@@ -265,7 +244,7 @@ fn push_pictures<'a>(jobs: &mut Vec<Job<'a>>, out: &'a Path, what: Planes<'a>) {
                 })
             }
         }
-    }));
+    });
 }
 
 /// A block of RGB rows from row `y` on, as pixels, and the plane indices they show.

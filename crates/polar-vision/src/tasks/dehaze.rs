@@ -5,12 +5,12 @@
 use polar_dehaze::{DehazeOptions, dehaze};
 use polar_eval::dehaze_metrics;
 use polar_image::Gray;
-use polar_io::Y_CHANNEL;
-use polar_io::files::vision;
+use polar_io::files::vision::{self, pictures};
 
-use super::{Context, Failure, Outcome, io, picture_path, to_json};
+use super::{Context, Failure, NOISY, Outcome, SPARSE, io, picture_path, to_json, write_plane};
 use crate::pictures::side_by_side;
 use crate::task_options::TaskArgs;
+use crate::writes::Writes;
 
 /// Runs the task.
 pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
@@ -19,17 +19,22 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
         ..DehazeOptions::default()
     };
     let d = dehaze(ctx.obs, &opts).map_err(|e| Failure::CannotRun(e.to_string()))?;
-    let out = ctx.out;
-    polar_io::write_exr(out.join(vision::DEHAZED), &d.radiance, Y_CHANNEL).map_err(io)?;
-    polar_io::write_exr(out.join(vision::TRANSMISSION), &d.transmission, Y_CHANNEL).map_err(io)?;
-    polar_io::write_exr(out.join(vision::HAZE_DEPTH), &d.depth, Y_CHANNEL).map_err(io)?;
-    let s0 = &ctx.obs.planes.s0;
-    let picture = side_by_side(&[s0, &d.radiance], Some(&d.transmission));
-    polar_io::write_rgb8_png(
-        picture_path(out, polar_io::files::vision::pictures::DEHAZE),
-        &picture,
-    )
-    .map_err(io)?;
+    let (out, s0) = (ctx.out, &ctx.obs.planes.s0);
+    let mut files = Writes::default();
+    for (name, plane, compression) in [
+        (vision::DEHAZED, &d.radiance, NOISY),
+        (vision::TRANSMISSION, &d.transmission, SPARSE),
+        (vision::HAZE_DEPTH, &d.depth, SPARSE),
+    ] {
+        files.push(name, move || {
+            write_plane(out.join(name), plane, compression)
+        });
+    }
+    files.push(pictures::DEHAZE, || {
+        let picture = side_by_side(&[s0, &d.radiance], Some(&d.transmission));
+        polar_io::write_rgb8_png(picture_path(out, pictures::DEHAZE), &picture)
+    });
+    files.run().map_err(io)?;
     let mut outcome = Outcome {
         metrics: None,
         messages: d.warnings.clone(),

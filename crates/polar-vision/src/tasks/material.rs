@@ -2,13 +2,15 @@
 //! material_confidence.exr and a colour picture; material metrics.
 
 use polar_eval::material_metrics;
-use polar_io::Y_CHANNEL;
-use polar_io::files::vision;
+use polar_io::files::vision::{self, pictures};
 use polar_material::{Classifier, MaterialOptions, classify};
 
-use super::{Context, Failure, Outcome, io, knn_message, picture_path, to_json};
+use super::{
+    Context, Failure, Outcome, SPARSE, io, knn_message, picture_path, to_json, write_plane,
+};
 use crate::pictures::{MATERIAL_PALETTE, label_error_picture, label_picture};
 use crate::task_options::TaskArgs;
+use crate::writes::Writes;
 
 /// Runs the task with the normals, object mask and transparency mask of earlier tasks,
 /// where they ran (one foreground for both tasks: sfp's follows the occluding contours).
@@ -24,19 +26,22 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     )
     .map_err(|e| Failure::CannotRun(e.to_string()))?;
     let out = ctx.out;
-    polar_io::write_gray8_png(out.join(vision::MATERIAL), &map.labels).map_err(io)?;
-    polar_io::write_exr(
-        out.join(vision::MATERIAL_CONFIDENCE),
-        &map.confidence,
-        Y_CHANNEL,
-    )
-    .map_err(io)?;
-    let picture = label_picture(&map.labels, &MATERIAL_PALETTE);
-    polar_io::write_rgb8_png(
-        picture_path(out, polar_io::files::vision::pictures::MATERIAL),
-        &picture,
-    )
-    .map_err(io)?;
+    let mut files = Writes::default();
+    files.push(vision::MATERIAL, || {
+        polar_io::write_gray8_png(out.join(vision::MATERIAL), &map.labels)
+    });
+    files.push(vision::MATERIAL_CONFIDENCE, || {
+        write_plane(
+            out.join(vision::MATERIAL_CONFIDENCE),
+            &map.confidence,
+            SPARSE,
+        )
+    });
+    files.push(pictures::MATERIAL, || {
+        let picture = label_picture(&map.labels, &MATERIAL_PALETTE);
+        polar_io::write_rgb8_png(picture_path(out, pictures::MATERIAL), &picture)
+    });
+    files.run().map_err(io)?;
     let mut outcome = Outcome::default();
     if let Classifier::Knn(m) = &clf {
         outcome.messages.push(knn_message(m.model()));

@@ -5,14 +5,17 @@
 
 use polar_eval::normal_metrics;
 use polar_imgproc::angular_error_map;
-use polar_io::files::vision;
-use polar_io::{RGB_CHANNELS, Y_CHANNEL};
+use polar_io::RGB_CHANNELS;
+use polar_io::files::vision::{self, pictures};
 use polar_shape::global::Light;
 use polar_shape::{Shape, ShapeOptions, estimate_shape};
 
-use super::{Context, Failure, Outcome, io, object_mask, picture_path, to_json};
+use super::{
+    Context, Failure, NOISY, Outcome, SPARSE, io, object_mask, picture_path, to_json, write_plane,
+};
 use crate::pictures::{REFLECTION_PALETTE, label_picture, normal_error_picture, normal_picture};
 use crate::task_options::TaskArgs;
+use crate::writes::Writes;
 
 /// Names of the reflection types, index = value of reflection.png.
 const REFLECTION_NAMES: [&str; 4] = ["none", "diffuse", "specular", "mixed"];
@@ -89,25 +92,29 @@ fn light_message(light: Option<&Light>) -> String {
 
 fn write(ctx: &Context<'_>, s: &Shape) -> Result<(), Failure> {
     let out = ctx.out;
-    polar_io::write_exr(out.join(vision::NORMAL), &s.normal, RGB_CHANNELS).map_err(io)?;
-    polar_io::write_exr(out.join(vision::DEPTH), &s.depth, Y_CHANNEL).map_err(io)?;
-    polar_io::write_exr(
-        out.join(vision::NORMAL_CONFIDENCE),
-        &s.confidence,
-        Y_CHANNEL,
-    )
-    .map_err(io)?;
-    polar_io::write_gray8_png(out.join(vision::REFLECTION), &s.reflection).map_err(io)?;
-    polar_io::write_rgb8_png(
-        picture_path(out, polar_io::files::vision::pictures::NORMAL),
-        &normal_picture(&s.normal),
-    )
-    .map_err(io)?;
-    let types = label_picture(&s.reflection, &REFLECTION_PALETTE);
-    polar_io::write_rgb8_png(
-        picture_path(out, polar_io::files::vision::pictures::REFLECTION),
-        &types,
-    )
-    .map_err(io)?;
+    let mut files = Writes::default();
+    files.push(vision::NORMAL, || {
+        polar_io::write_exr_with(out.join(vision::NORMAL), &s.normal, RGB_CHANNELS, NOISY)
+    });
+    files.push(vision::DEPTH, || {
+        write_plane(out.join(vision::DEPTH), &s.depth, SPARSE)
+    });
+    files.push(vision::NORMAL_CONFIDENCE, || {
+        write_plane(out.join(vision::NORMAL_CONFIDENCE), &s.confidence, SPARSE)
+    });
+    files.push(vision::REFLECTION, || {
+        polar_io::write_gray8_png(out.join(vision::REFLECTION), &s.reflection)
+    });
+    files.push(pictures::NORMAL, || {
+        polar_io::write_rgb8_png(
+            picture_path(out, pictures::NORMAL),
+            &normal_picture(&s.normal),
+        )
+    });
+    files.push(pictures::REFLECTION, || {
+        let types = label_picture(&s.reflection, &REFLECTION_PALETTE);
+        polar_io::write_rgb8_png(picture_path(out, pictures::REFLECTION), &types)
+    });
+    files.run().map_err(io)?;
     Ok(())
 }

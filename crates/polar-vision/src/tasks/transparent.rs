@@ -4,28 +4,35 @@
 
 use polar_eval::mask_metrics;
 use polar_image::Gray;
-use polar_io::files::vision;
-use polar_io::{MaterialLabel, Y_CHANNEL};
+use polar_io::MaterialLabel;
+use polar_io::files::vision::{self, pictures};
 use polar_transparency::{Segmenter, TransparencyOptions, detect};
 
-use super::{Context, Failure, Outcome, io, knn_message, picture_path, to_json};
+use super::{
+    Context, Failure, NOISY, Outcome, io, knn_message, picture_path, to_json, write_plane,
+};
 use crate::pictures::{mask_error_picture, overlay_picture};
 use crate::task_options::TaskArgs;
+use crate::writes::Writes;
 
 /// Runs the task; leaves the mask for `material`.
 pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     let segmenter = args.transparent_segmenter()?;
     let map = detect(ctx.obs, &segmenter, &TransparencyOptions::default())
         .map_err(|e| Failure::CannotRun(e.to_string()))?;
-    let out = ctx.out;
-    polar_io::write_gray8_png(out.join(vision::TRANSPARENT), &map.mask).map_err(io)?;
-    polar_io::write_exr(out.join(vision::TRANSPARENT_SCORE), &map.score, Y_CHANNEL).map_err(io)?;
-    let picture = overlay_picture(&ctx.obs.planes.s0, &map.mask);
-    polar_io::write_rgb8_png(
-        picture_path(out, polar_io::files::vision::pictures::TRANSPARENT),
-        &picture,
-    )
-    .map_err(io)?;
+    let (out, s0) = (ctx.out, &ctx.obs.planes.s0);
+    let mut files = Writes::default();
+    files.push(vision::TRANSPARENT, || {
+        polar_io::write_gray8_png(out.join(vision::TRANSPARENT), &map.mask)
+    });
+    files.push(vision::TRANSPARENT_SCORE, || {
+        write_plane(out.join(vision::TRANSPARENT_SCORE), &map.score, NOISY)
+    });
+    files.push(pictures::TRANSPARENT, || {
+        let picture = overlay_picture(s0, &map.mask);
+        polar_io::write_rgb8_png(picture_path(out, pictures::TRANSPARENT), &picture)
+    });
+    files.run().map_err(io)?;
     let mut outcome = Outcome::default();
     if let Segmenter::Knn(m) = &segmenter {
         outcome.messages.push(knn_message(m.model()));
