@@ -125,7 +125,6 @@ impl Output {
     ];
 }
 
-/// One output file's encoding: the file's name and the work.
 /// What the outputs show: the Stokes planes (of the luminance for a colour mosaic) and,
 /// for a colour mosaic, each colour's planes.
 #[derive(Clone, Copy, Debug)]
