@@ -37,6 +37,10 @@ def psnr(reference, image, data_range):
 
 def oracles(sample):
     """(hidden share, hazy PSNR, gain of `seen`, gain of `guessed`) of one sample folder."""
+    needed = [sample / "gt" / "transmission.exr", sample / "stokes.exr"]
+    missing = [str(p) for p in needed if not p.is_file()]
+    if missing:
+        raise SystemExit(f"{sample}: no {', '.join(missing)} (a haze sample needs both beside gt/dehazed.exr)")
     t = read_exr(sample / "gt" / "transmission.exr")["Y"]
     truth = read_exr(sample / "gt" / "dehazed.exr")["Y"].astype(np.float64)
     hazy = read_exr(sample / "stokes.exr")["S0"].astype(np.float64)
