@@ -1,10 +1,10 @@
 //! Binary masks as `bool` planes (row-major, `w x h`): closing and opening (equal to the
 //! grey-scale operators on 0/1 images), hole filling and small-component removal with the labelling,
-//! splitting at narrow necks; the clean-up the segmenting tasks (material regions,
-//! transparency masks) share.
+//! splitting at narrow necks, convex hulls per component or over the arcs of one broken
+//! outline; the clean-up the segmenting tasks (material regions, transparency masks) share.
 
 use crate::morph::{check_kernel, runs};
-use crate::{Connectivity, MorphShape, close, label, open};
+use crate::{Connectivity, MorphShape, close, label, max_filter, open};
 use polar_image::Gray;
 
 use crate::Error;
@@ -275,28 +275,154 @@ pub fn remove_small(m: &[bool], w: usize, h: usize, min_area: usize) -> Result<V
 /// the arithmetic is exact (coordinates doubled to integers).
 pub fn convex_hull_objects(m: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
     let (lab, n) = components(m, w, h)?;
-    // Per component and row, the leftmost and rightmost pixel: the hull's only candidates.
-    let mut extremes: Vec<Vec<(usize, usize, usize)>> = vec![Vec::new(); n + 1];
+    Ok(filled_hulls(&row_extremes(&lab, n, w, h), w, h))
+}
+
+/// The union of the convex hulls of the pixel sets given by their row extremes (as
+/// [`row_extremes`] gives them).
+fn filled_hulls(sets: &[Vec<(usize, usize, usize)>], w: usize, h: usize) -> Vec<bool> {
+    let mut out = vec![false; w * h];
+    for (y, lo, hi) in sets.iter().flat_map(|rows| hull_runs(rows, w)) {
+        out[y * w + lo..=y * w + hi].fill(true);
+    }
+    out
+}
+
+/// Per label `1..=n` of `lab` (at index `label - 1`), its leftmost and rightmost pixel in
+/// each row it has pixels in, `(y, left, right)` by increasing `y`: all a convex hull needs.
+fn row_extremes(lab: &[u32], n: usize, w: usize, h: usize) -> Vec<Vec<(usize, usize, usize)>> {
+    let mut extremes: Vec<Vec<(usize, usize, usize)>> = vec![Vec::new(); n];
     for y in 0..h {
         let row = &lab[y * w..(y + 1) * w];
         for (x, &l) in row.iter().enumerate() {
             if l == 0 {
                 continue;
             }
-            match extremes[l as usize].last_mut() {
+            match extremes[l as usize - 1].last_mut() {
                 Some((ey, _, right)) if *ey == y => *right = x,
-                _ => extremes[l as usize].push((y, x, x)),
+                _ => extremes[l as usize - 1].push((y, x, x)),
             }
         }
     }
-    let mut out = vec![false; w * h];
-    for rows in &extremes[1..] {
-        let hull = hull_of_edge_midpoints(rows);
-        for (y, lo, hi) in hull_rows(&hull, w) {
-            out[y * w + lo..=y * w + hi].fill(true);
+    extremes
+}
+
+/// The pixel runs `(y, first x, last x)` of the convex hull of the pixels whose row
+/// extremes are `rows` (as [`row_extremes`] gives them), clipped to the width `w`.
+fn hull_runs(rows: &[(usize, usize, usize)], w: usize) -> Vec<(usize, usize, usize)> {
+    match rows.is_empty() {
+        true => Vec::new(),
+        false => hull_rows(&hull_of_edge_midpoints(rows), w),
+    }
+}
+
+/// Convex hulls of the 8-connected components of `m`, as [`convex_hull_objects`], except
+/// that components within `gap` pixels of each other (Chebyshev) may share one: two sets
+/// of components are joined where at least `min_coverage` of their joint hull's outline
+/// pixels lie within `near` pixels of `m`, the best-covered pair first, the joined sets
+/// again. So the arcs of one object's broken outline take one hull; two objects side by
+/// side keep theirs, as their joint hull adds two edges across the background between
+/// them. (Short arcs that outline a hull only all together, as four quarters of a ring,
+/// stay apart: no pair of them passes.)
+pub fn convex_hulls_joined(
+    m: &[bool],
+    w: usize,
+    h: usize,
+    gap: usize,
+    near: usize,
+    min_coverage: f32,
+) -> Result<Vec<bool>, Error> {
+    let (lab, n) = components(m, w, h)?;
+    let pairs = neighbour_pairs(&lab, n, w, h, gap)?;
+    let near = grown(m, w, h, near)?;
+    let mut rows = row_extremes(&lab, n, w, h);
+    // Union-find over the labels `1..=n`; a set's row extremes move to its root.
+    let mut root: Vec<usize> = (0..=n).collect();
+    let find = |root: &[usize], mut c: usize| {
+        while root[c] != c {
+            c = root[c];
+        }
+        c
+    };
+    loop {
+        let best = (pairs.iter())
+            .map(|&(a, b)| (find(&root, a), find(&root, b)))
+            .filter(|(a, b)| a != b)
+            .map(|(a, b)| {
+                let joint: Vec<_> = rows[a - 1].iter().chain(&rows[b - 1]).copied().collect();
+                (outline_coverage(&hull_runs(&joint, w), &near, w), a, b)
+            })
+            .filter(|&(c, _, _)| c >= min_coverage)
+            .max_by(|x, y| x.0.total_cmp(&y.0));
+        let Some((_, a, b)) = best else { break };
+        root[b] = a;
+        let moved = std::mem::take(&mut rows[b - 1]);
+        rows[a - 1].extend(moved);
+    }
+    Ok(filled_hulls(&rows, w, h))
+}
+
+/// `m` grown by `r` pixels (a square of side `2r + 1`).
+fn grown(m: &[bool], w: usize, h: usize, r: usize) -> Result<Vec<bool>, Error> {
+    let src = Gray::from_vec(w, h, m.iter().map(|&b| f32::from(u8::from(b))).collect())
+        .expect("mask size");
+    let mut dst = Gray::new(w, h);
+    max_filter(&src, &mut dst, 2 * r + 1, 2 * r + 1)?;
+    Ok(dst.as_slice().iter().map(|&v| v > 0.5).collect())
+}
+
+/// The pairs `(a, b)`, `a < b`, of labels `1..=n` of `lab` whose pixels come within `gap`
+/// pixels (Chebyshev) of each other: the smallest and largest label in each pixel's
+/// window of side `gap + 1` (labels up to 2^24, exact as `f32`).
+fn neighbour_pairs(
+    lab: &[u32],
+    n: usize,
+    w: usize,
+    h: usize,
+    gap: usize,
+) -> Result<Vec<(usize, usize)>, Error> {
+    let window_max = |f: &dyn Fn(u32) -> f32| -> Result<Vec<f32>, Error> {
+        let src = Gray::from_vec(w, h, lab.iter().map(|&l| f(l)).collect()).expect("mask size");
+        let mut dst = Gray::new(w, h);
+        max_filter(&src, &mut dst, gap + 1, gap + 1)?;
+        Ok(dst.into_vec())
+    };
+    let largest = window_max(&|l| l as f32)?;
+    // The smallest label is `n + 1` less the largest of `n + 1 - label`.
+    let smallest = window_max(&|l| {
+        if l == 0 {
+            0.0
+        } else {
+            (n + 1 - l as usize) as f32
+        }
+    })?;
+    let mut pairs: Vec<(usize, usize)> = (0..w * h)
+        .filter(|&k| smallest[k] > 0.0)
+        .map(|k| (n + 1 - smallest[k] as usize, largest[k] as usize))
+        .filter(|(a, b)| a < b)
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    Ok(pairs)
+}
+
+/// Share of the outline pixels of the convex region `runs` (one run per row, consecutive
+/// rows, as [`hull_runs`] gives them) that are set in `near`.
+fn outline_coverage(runs: &[(usize, usize, usize)], near: &[bool], w: usize) -> f32 {
+    let covers = |i: Option<usize>, x: usize| {
+        i.and_then(|i| runs.get(i))
+            .is_some_and(|&(_, lo, hi)| (lo..=hi).contains(&x))
+    };
+    let (mut on, mut all) = (0usize, 0usize);
+    for (i, &(y, lo, hi)) in runs.iter().enumerate() {
+        for x in lo..=hi {
+            if x == lo || x == hi || !covers(i.checked_sub(1), x) || !covers(Some(i + 1), x) {
+                all += 1;
+                on += usize::from(near[y * w + x]);
+            }
         }
     }
-    Ok(out)
+    on as f32 / all.max(1) as f32
 }
 
 /// Convex hull (Andrew's monotone chain, counter-clockwise, collinear points dropped) of
@@ -514,6 +640,52 @@ mod tests {
         }
         assert!(!hull[9 * w + 19], "nothing between the two arcs");
         assert!(!hull[0] && !hull[w - 1]);
+    }
+
+    /// A 3-pixel-wide ring of radius 14 around `(cx, 20)` on a 96x40 mask, cut into `arcs`
+    /// arcs (2 or 4) by gaps of `half_gap` degrees either side of the horizontal (and of
+    /// the vertical).
+    fn ring_in_arcs(m: &mut [bool], w: usize, cx: f64, arcs: u8, half_gap: f64) {
+        let half = f64::from(arcs) / 2.0;
+        for (k, px) in m.iter_mut().enumerate() {
+            let (dx, dy) = ((k % w) as f64 - cx, (k / w) as f64 - 20.0);
+            let gap = (half * dy.atan2(dx)).sin().abs() < (half * half_gap.to_radians()).sin();
+            *px |= (12.5..=15.5).contains(&dx.hypot(dy)) && !gap;
+        }
+    }
+
+    /// The two arcs of each of two rings (cut by 9-10 pixel gaps at the sides) take one
+    /// hull per ring; the rings, side by side within the gap, keep their own (their joint
+    /// hull's outline runs over the background between them); with no gap the result is
+    /// [`convex_hull_objects`]. Four quarters of a ring stay apart: no pair outlines its
+    /// joint hull.
+    #[test]
+    fn arcs_of_one_outline_take_one_hull_objects_side_by_side_do_not() {
+        let (w, h) = (96, 40);
+        let mut m = vec![false; w * h];
+        ring_in_arcs(&mut m, w, 24.0, 2, 20.0);
+        ring_in_arcs(&mut m, w, 60.0, 2, 20.0);
+        let apart = convex_hull_objects(&m, w, h).unwrap();
+        assert_eq!(convex_hulls_joined(&m, w, h, 0, 2, 0.8).unwrap(), apart);
+        assert!(
+            !apart[20 * w + 24] && !apart[20 * w + 60],
+            "arcs alone leave the centres"
+        );
+        let joined = convex_hulls_joined(&m, w, h, 12, 2, 0.8).unwrap();
+        for x in [11, 24, 37, 47, 60, 73] {
+            assert!(joined[20 * w + x], "x = {x}: centres and sides filled");
+        }
+        assert!(!joined[20 * w + 42], "nothing between the two rings");
+        assert!(
+            joined.iter().zip(&apart).all(|(&j, &a)| j || !a),
+            "joining only adds pixels"
+        );
+        let mut quarters = vec![false; w * h];
+        ring_in_arcs(&mut quarters, w, 24.0, 4, 12.0);
+        assert_eq!(
+            convex_hulls_joined(&quarters, w, h, 12, 2, 0.8).unwrap(),
+            convex_hull_objects(&quarters, w, h).unwrap()
+        );
     }
 
     /// The run-distance closing-opening equals the grey-scale one exactly, on

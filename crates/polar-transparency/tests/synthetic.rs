@@ -149,18 +149,51 @@ fn dark_glossy_opaque_disc_is_no_glass() {
 /// (a fifth of the disc) is lost, so the IoU is at most 0.8. The arc alone: about 0.35.
 #[test]
 fn glass_polarized_along_an_open_arc_is_filled() {
-    let obs = observation(|x, y| match disc(x, y) {
-        Some((ze, az)) if ze > 0.7 && az.cos() > -0.5 => (
-            0.9 * checker(x, y),
-            2.0 * transmitted_dolp(ze, 1.5),
-            az + FRAC_PI_2,
-        ),
-        Some(_) => (0.9 * checker(x, y), 0.0, 0.0),
-        None => (checker(x, y), 0.0, 0.0),
-    });
+    let obs = disc_polarized_where(|ze, az| ze > 0.7 && az.cos() > -0.5, FRAC_PI_2);
     let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
     let iou = iou_with_disc(&out.mask);
     assert!(iou > 0.7, "IoU {iou}");
+}
+
+/// The glass disc over the checkerboard polarized (twice its transmission's DoLP, the AoLP
+/// `phase` from the azimuth) where `polarized(zenith, azimuth)`, depolarized elsewhere.
+fn disc_polarized_where(polarized: impl Fn(f64, f64) -> bool, phase: f64) -> Observation {
+    observation(|x, y| match disc(x, y) {
+        Some((ze, az)) if polarized(ze, az) => (
+            0.9 * checker(x, y),
+            2.0 * transmitted_dolp(ze, 1.5),
+            az + phase,
+        ),
+        Some(_) => (0.9 * checker(x, y), 0.0, 0.0),
+        None => (checker(x, y), 0.0, 0.0),
+    })
+}
+
+/// Glass whose rim is polarized in two arcs, top and bottom, the sides depolarized (where
+/// reflection and transmission cancel) and so the face: each arc's own hull is the
+/// circular segment beyond its chord; the two take one hull, the disc.
+#[test]
+fn glass_rim_polarized_in_two_arcs_takes_one_hull() {
+    let obs = disc_polarized_where(|ze, az| ze > 0.7 && az.sin().abs() > 0.3, 0.0);
+    let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
+    let iou = iou_with_disc(&out.mask);
+    assert!(iou > 0.85, "IoU {iou}");
+}
+
+/// Two glass discs 12 pixels apart (`JOIN_GAP` of the frame) keep their own hulls: the
+/// one over both would run over the checkerboard between them.
+#[test]
+fn glass_discs_side_by_side_stay_apart() {
+    let obs = observation(|x, y| {
+        match disc_at(25.0, 48.0, 17.0, x, y).or_else(|| disc_at(71.0, 48.0, 17.0, x, y)) {
+            Some((ze, az)) => (0.9 * checker(x, y), transmitted_dolp(ze, 1.5), az),
+            None => (checker(x, y), 0.0, 0.0),
+        }
+    });
+    let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
+    let on = |x: usize, y: usize| out.mask.as_slice()[y * N + x] == ON;
+    assert!(on(25, 48) && on(71, 48), "both discs found");
+    assert!((30..66).all(|y| !on(48, y)), "nothing between them");
 }
 
 /// Score maps with three levels: a background over most of the frame, weakly polarized
