@@ -317,26 +317,27 @@ fn hull_runs(rows: &[(usize, usize, usize)], w: usize) -> Vec<(usize, usize, usi
 }
 
 /// Convex hulls of the 8-connected components of `m`, as [`convex_hull_objects`], except
-/// that components within `gap` pixels of each other (Chebyshev) may share one: two sets
-/// of components are joined where at least `min_coverage` of their joint hull's outline
-/// pixels lie within `near` pixels of `m`, the best-covered pair first, the joined sets
-/// again. So the arcs of one object's broken outline take one hull; two objects side by
-/// side keep theirs, as their joint hull adds two edges across the background between
-/// them. (Short arcs that outline a hull only all together, as four quarters of a ring,
-/// stay apart: no pair of them passes.)
+/// that components within `join.gap` pixels of each other (Chebyshev) may share one: two
+/// sets of components are joined where at least `join.min_coverage` of their joint hull's
+/// outline pixels lie within `join.near` pixels of `m` and their pixels cover at most
+/// `join.max_fill` of it, the best-covered pair first, the joined sets again. So the arcs of
+/// one object's broken outline take one hull; two objects side by side keep theirs, as
+/// their joint hull adds two edges across the background between them, or, where they are
+/// so close that those edges are short, as they fill it. (Short arcs that outline a hull
+/// only all together, as four quarters of a ring, stay apart: no pair of them passes.)
 pub fn convex_hulls_joined(
     m: &[bool],
     w: usize,
     h: usize,
-    gap: usize,
-    near: usize,
-    min_coverage: f32,
+    join: &ArcJoin,
 ) -> Result<Vec<bool>, Error> {
     let (lab, n) = components(m, w, h)?;
-    let pairs = neighbour_pairs(&lab, n, w, h, gap)?;
-    let near = grown(m, w, h, near)?;
+    let pairs = neighbour_pairs(&lab, n, w, h, join.gap)?;
+    let near = grown(m, w, h, join.near)?;
     let mut rows = row_extremes(&lab, n, w, h);
-    // Union-find over the labels `1..=n`; a set's row extremes move to its root.
+    let mut area = vec![0usize; n + 1];
+    lab.iter().for_each(|&l| area[l as usize] += 1);
+    // Union-find over the labels `1..=n`; a set's row extremes and area move to its root.
     let mut root: Vec<usize> = (0..=n).collect();
     let find = |root: &[usize], mut c: usize| {
         while root[c] != c {
@@ -348,19 +349,67 @@ pub fn convex_hulls_joined(
         let best = (pairs.iter())
             .map(|&(a, b)| (find(&root, a), find(&root, b)))
             .filter(|(a, b)| a != b)
-            .map(|(a, b)| {
+            .filter_map(|(a, b)| {
                 let joint: Vec<_> = rows[a - 1].iter().chain(&rows[b - 1]).copied().collect();
-                (outline_coverage(&hull_runs(&joint, w), &near, w), a, b)
+                let runs = hull_runs(&joint, w);
+                let hull: usize = runs.iter().map(|&(_, lo, hi)| hi - lo + 1).sum();
+                let fill = (area[a] + area[b]) as f32 / hull.max(1) as f32;
+                let coverage = outline_coverage(&runs, &near, w);
+                (fill <= join.max_fill && coverage >= join.min_coverage).then_some((coverage, a, b))
             })
-            .filter(|&(c, _, _)| c >= min_coverage)
             .max_by(|x, y| x.0.total_cmp(&y.0));
         let Some((_, a, b)) = best else { break };
         root[b] = a;
         let moved = std::mem::take(&mut rows[b - 1]);
         rows[a - 1].extend(moved);
+        area[a] += area[b];
     }
     Ok(filled_hulls(&rows, w, h))
 }
+
+/// How [`convex_hulls_joined`] joins components.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArcJoin {
+    /// Largest gap (pixels, Chebyshev) between two components it may join.
+    pub gap: usize,
+    /// Distance (pixels) from the mask within which a joint hull's outline counts as
+    /// covered.
+    pub near: usize,
+    /// Least share of the joint hull's outline covered.
+    pub min_coverage: f32,
+    /// Largest share of the joint hull the components' pixels may fill.
+    pub max_fill: f32,
+}
+
+impl ArcJoin {
+    /// The defaults for the arcs of an object's rim in a `w x h` frame, with an outline
+    /// tolerance of `near` pixels: a gap of [`ARC_GAP`] of the shorter side, at least
+    /// [`ARC_COVERAGE`] covered, at most [`ARC_MAX_FILL`] filled.
+    pub fn rim_arcs(w: usize, h: usize, near: usize) -> Self {
+        ArcJoin {
+            gap: (ARC_GAP * w.min(h) as f32).round() as usize,
+            near,
+            min_coverage: ARC_COVERAGE,
+            max_fill: ARC_MAX_FILL,
+        }
+    }
+}
+
+/// The gap [`ArcJoin::rim_arcs`] bridges, as a share of the frame's shorter side: an
+/// object's rim seen as coherent arcs (a glass ball's, where reflection and transmission
+/// cancel between them; an opaque one's, where the diffuse and specular phases do) breaks
+/// over less than this.
+pub const ARC_GAP: f32 = 0.125;
+
+/// The share of a joint hull's outline [`ArcJoin::rim_arcs`] asks to lie along the mask:
+/// between what the joint hulls of one rim's arcs and those of two objects side by side
+/// reach on the dev frames (docs/benchmarks.md, "one hull over a rim's arcs").
+pub const ARC_COVERAGE: f32 = 0.8;
+
+/// The largest share of their joint hull [`ArcJoin::rim_arcs`] lets the components fill:
+/// the arcs of a rim leave its face empty, two solid objects close together fill most of
+/// the hull around them.
+pub const ARC_MAX_FILL: f32 = 0.75;
 
 /// `m` grown by `r` pixels (a square of side `2r + 1`).
 fn grown(m: &[bool], w: usize, h: usize, r: usize) -> Result<Vec<bool>, Error> {
@@ -662,16 +711,20 @@ mod tests {
     #[test]
     fn arcs_of_one_outline_take_one_hull_objects_side_by_side_do_not() {
         let (w, h) = (96, 40);
+        let join = |gap| ArcJoin {
+            gap,
+            ..ArcJoin::rim_arcs(w, h, 2)
+        };
         let mut m = vec![false; w * h];
         ring_in_arcs(&mut m, w, 24.0, 2, 20.0);
         ring_in_arcs(&mut m, w, 60.0, 2, 20.0);
         let apart = convex_hull_objects(&m, w, h).unwrap();
-        assert_eq!(convex_hulls_joined(&m, w, h, 0, 2, 0.8).unwrap(), apart);
+        assert_eq!(convex_hulls_joined(&m, w, h, &join(0)).unwrap(), apart);
         assert!(
             !apart[20 * w + 24] && !apart[20 * w + 60],
             "arcs alone leave the centres"
         );
-        let joined = convex_hulls_joined(&m, w, h, 12, 2, 0.8).unwrap();
+        let joined = convex_hulls_joined(&m, w, h, &join(12)).unwrap();
         for x in [11, 24, 37, 47, 60, 73] {
             assert!(joined[20 * w + x], "x = {x}: centres and sides filled");
         }
@@ -683,9 +736,33 @@ mod tests {
         let mut quarters = vec![false; w * h];
         ring_in_arcs(&mut quarters, w, 24.0, 4, 12.0);
         assert_eq!(
-            convex_hulls_joined(&quarters, w, h, 12, 2, 0.8).unwrap(),
+            convex_hulls_joined(&quarters, w, h, &join(12)).unwrap(),
             convex_hull_objects(&quarters, w, h).unwrap()
         );
+    }
+
+    /// Two solid boxes 4 pixels apart outline their joint hull all but across the gap, but
+    /// fill nine tenths of it: two objects, not the arcs of one; with no cap on the fill
+    /// they would be joined.
+    #[test]
+    fn solid_objects_close_together_keep_their_hulls() {
+        let (w, h) = (64, 40);
+        let m: Vec<bool> = (0..w * h)
+            .map(|k| {
+                let (x, y) = (k % w, k / w);
+                (4..36).contains(&y) && ((6..30).contains(&x) || (34..58).contains(&x))
+            })
+            .collect();
+        let rim = ArcJoin::rim_arcs(w, h, 2);
+        assert_eq!(
+            convex_hulls_joined(&m, w, h, &rim).unwrap(),
+            convex_hull_objects(&m, w, h).unwrap()
+        );
+        let uncapped = ArcJoin {
+            max_fill: 1.0,
+            ..rim
+        };
+        assert!(convex_hulls_joined(&m, w, h, &uncapped).unwrap()[20 * w + 32]);
     }
 
     /// The run-distance closing-opening equals the grey-scale one exactly, on

@@ -160,6 +160,11 @@ const HULL_NECK: f32 = 0.3;
 /// ... where both inscribed radii reach this share of the image's shorter side: the
 /// thinner arcs of one object's rim stay together, and their hull is its face.
 const HULL_BLOB: f32 = 0.05;
+/// Blobs a short way apart share one hull in [`fill_hull_gaps`] where their joint hull's
+/// outline runs within this many pixels of them and they leave part of it empty
+/// ([`polar_imgproc::mask::ArcJoin::rim_arcs`]): the arcs of one rim, broken where the
+/// diffuse and specular phases cancel.
+const ARC_NEAR: usize = 2;
 /// Passes of [`trim_boundary`] (each peels at most one pixel).
 const TRIM_PASSES: usize = 2;
 /// Half-width (pixels) of the window [`trim_boundary`] compares a boundary pixel in.
@@ -491,7 +496,8 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
 
 /// The union of the convex hulls of `fg`'s blobs: its components cut at narrow necks
 /// ([`HULL_NECK`], [`HULL_BLOB`]; inscribed radii as the material rule's, the frame's
-/// edge counting as background), the pixels where two blobs meet left out.
+/// edge counting as background), the pixels where two blobs meet left out, blobs that are
+/// the arcs of one rim under one hull ([`ARC_NEAR`]).
 fn hull_per_blob(fg: &[bool], w: usize, h: usize) -> Result<Vec<bool>, ShapeError> {
     let dist: Vec<f32> = distance_to_background(fg, w, h, Outside::Background)
         .into_iter()
@@ -508,7 +514,10 @@ fn hull_per_blob(fg: &[bool], w: usize, h: usize) -> Result<Vec<bool>, ShapeErro
                     .all(|b| (x.saturating_sub(1)..=(x + 1).min(w - 1)).all(|a| alone(a, b)))
         })
         .collect();
-    Ok(polar_imgproc::mask::convex_hull_objects(&apart, w, h)?)
+    let join = polar_imgproc::mask::ArcJoin::rim_arcs(w, h, ARC_NEAR);
+    Ok(polar_imgproc::mask::convex_hulls_joined(
+        &apart, w, h, &join,
+    )?)
 }
 
 /// `fg` without the boundary pixels (those with a 4-neighbour outside `fg`) whose log

@@ -12,7 +12,7 @@
 //! background's level and by the noise's; or a given threshold), lets the seeds along the
 //! frame's edge follow their neighbours inside ([`BORDER`]), closes and opens the mask,
 //! fills holes (background components not touching the border), drops specks, replaces
-//! each component by its convex hull (arcs of one rim by one hull, [`JOIN_GAP`]) and trims
+//! each component by its convex hull (arcs of one rim by one hull) and trims
 //! the depolarized rim that the window added around it, all with polar-imgproc. The hull is
 //! there because glass is polarized mostly along its rims and edges (reflection and
 //! transmission both grow toward grazing) and little where it faces the camera, so the
@@ -281,33 +281,19 @@ fn border_from_inside(seed: Vec<bool>, w: usize, h: usize) -> Vec<bool> {
     (0..w * h).map(|k| seed[inner(k)]).collect()
 }
 
-/// Mask components up to this share of the frame's shorter side apart may take one convex
-/// hull ([`polar_imgproc::mask::convex_hulls_joined`]): a glass ball's or ring's rim is
-/// polarized in arcs, cut where reflection (polarized across the plane of incidence) and
-/// transmission (along it) cancel and where neither is strong.
-pub const JOIN_GAP: f32 = 0.125;
-
-/// The joint hull is taken where at least this share of its outline lies within half a
-/// cue window of the mask: the arcs of one rim outline it, whereas the hull over two
-/// objects side by side bridges the background between them.
-pub const MIN_OUTLINE_COVERAGE: f32 = 0.8;
-
 /// The convex hulls of `mask`'s components that are not darker than their surroundings
 /// ([`without_dark_regions`], judged on each component's own hull: joined first, a dark
 /// glossy object would share a hull with the lit specks around it), components
-/// [`JOIN_GAP`] apart sharing one where [`MIN_OUTLINE_COVERAGE`] holds.
+/// close enough sharing one ([`polar_imgproc::mask::ArcJoin::rim_arcs`]): a glass
+/// ball's or ring's rim is polarized in arcs, cut where reflection (polarized across the
+/// plane of incidence) and transmission (along it) cancel and where neither is strong.
 fn lit_hulls(obs: &Observation, mask: Vec<bool>) -> Result<Vec<bool>, TransparencyError> {
     let (w, h) = obs.size();
     let lit = without_dark_regions(obs, polar_imgproc::mask::convex_hull_objects(&mask, w, h)?)?;
     let seeds: Vec<bool> = mask.iter().zip(&lit).map(|(&s, &l)| s && l).collect();
-    let gap = (JOIN_GAP * w.min(h) as f32).round() as usize;
+    let join = polar_imgproc::mask::ArcJoin::rim_arcs(w, h, cues::WINDOW / 2);
     Ok(polar_imgproc::mask::convex_hulls_joined(
-        &seeds,
-        w,
-        h,
-        gap,
-        cues::WINDOW / 2,
-        MIN_OUTLINE_COVERAGE,
+        &seeds, w, h, &join,
     )?)
 }
 

@@ -180,7 +180,7 @@ fn glass_rim_polarized_in_two_arcs_takes_one_hull() {
     assert!(iou > 0.85, "IoU {iou}");
 }
 
-/// Two glass discs 12 pixels apart (`JOIN_GAP` of the frame) keep their own hulls: the
+/// Two glass discs 12 pixels apart (`ARC_GAP` of the frame) keep their own hulls: the
 /// one over both would run over the checkerboard between them.
 #[test]
 fn glass_discs_side_by_side_stay_apart() {
