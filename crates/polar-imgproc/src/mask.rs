@@ -324,7 +324,8 @@ fn hull_runs(rows: &[(usize, usize, usize)], w: usize) -> Vec<(usize, usize, usi
 /// one object's broken outline take one hull; two objects side by side keep theirs, as
 /// their joint hull adds two edges across the background between them, or, where they are
 /// so close that those edges are short, as they fill it. (Short arcs that outline a hull
-/// only all together, as four quarters of a ring, stay apart: no pair of them passes.)
+/// only all together, as four quarters of a ring, stay apart: no pair of them passes; nor
+/// is anything joined where more than [`MAX_LINKS`] pairs are within the gap.)
 pub fn convex_hulls_joined(
     m: &[bool],
     w: usize,
@@ -332,12 +333,27 @@ pub fn convex_hulls_joined(
     join: &ArcJoin,
 ) -> Result<Vec<bool>, Error> {
     let (lab, n) = components(m, w, h)?;
-    let pairs = neighbour_pairs(&lab, n, w, h, join.gap)?;
+    if n >= 1 << 24 {
+        // Labels past f32's integers: no pairs can be told apart (a checkerboard of
+        // single pixels over 32 megapixels); one hull per component.
+        return convex_hull_objects(m, w, h);
+    }
     let near = grown(m, w, h, join.near)?;
     let mut rows = row_extremes(&lab, n, w, h);
     let mut area = vec![0usize; n + 1];
     lab.iter().for_each(|&l| area[l as usize] += 1);
+    // The coverage of the joint hull of the sets whose roots are `a` and `b`, where it
+    // passes.
+    let judge = |rows: &[Vec<(usize, usize, usize)>], area: &[usize], a: usize, b: usize| {
+        let joint: Vec<_> = rows[a - 1].iter().chain(&rows[b - 1]).copied().collect();
+        let runs = hull_runs(&joint, w);
+        let hull: usize = runs.iter().map(|&(_, lo, hi)| hi - lo + 1).sum();
+        let fill = (area[a] + area[b]) as f32 / hull.max(1) as f32;
+        let coverage = outline_coverage(&runs, &near, w);
+        (fill <= join.max_fill && coverage >= join.min_coverage).then_some(coverage)
+    };
     // Union-find over the labels `1..=n`; a set's row extremes and area move to its root.
+    // The linked pairs of roots keep their judgement until one of them is joined.
     let mut root: Vec<usize> = (0..=n).collect();
     let find = |root: &[usize], mut c: usize| {
         while root[c] != c {
@@ -345,27 +361,39 @@ pub fn convex_hulls_joined(
         }
         c
     };
-    loop {
-        let best = (pairs.iter())
-            .map(|&(a, b)| (find(&root, a), find(&root, b)))
-            .filter(|(a, b)| a != b)
-            .filter_map(|(a, b)| {
-                let joint: Vec<_> = rows[a - 1].iter().chain(&rows[b - 1]).copied().collect();
-                let runs = hull_runs(&joint, w);
-                let hull: usize = runs.iter().map(|&(_, lo, hi)| hi - lo + 1).sum();
-                let fill = (area[a] + area[b]) as f32 / hull.max(1) as f32;
-                let coverage = outline_coverage(&runs, &near, w);
-                (fill <= join.max_fill && coverage >= join.min_coverage).then_some((coverage, a, b))
-            })
-            .max_by(|x, y| x.0.total_cmp(&y.0));
-        let Some((_, a, b)) = best else { break };
+    let pairs = neighbour_pairs(&lab, n, w, h, join.gap)?;
+    if pairs.len() > MAX_LINKS {
+        return Ok(filled_hulls(&rows, w, h));
+    }
+    let mut links: Vec<(usize, usize, Option<f32>)> = (pairs.into_iter())
+        .map(|(a, b)| (a, b, judge(&rows, &area, a, b)))
+        .collect();
+    while let Some((_, a, b)) = (links.iter())
+        .filter_map(|&(x, y, c)| c.map(|c| (c, x, y)))
+        .max_by(|p, q| p.0.total_cmp(&q.0))
+    {
         root[b] = a;
         let moved = std::mem::take(&mut rows[b - 1]);
         rows[a - 1].extend(moved);
         area[a] += area[b];
+        links = (links.into_iter())
+            .map(|(x, y, c)| (find(&root, x), find(&root, y), c))
+            .filter(|(x, y, _)| x != y)
+            .map(|(x, y, c)| (x.min(y), x.max(y), c))
+            .collect();
+        links.sort_unstable_by_key(|&(x, y, _)| (x, y));
+        links.dedup_by_key(|l| (l.0, l.1));
+        for l in links.iter_mut().filter(|l| l.0 == a || l.1 == a) {
+            l.2 = judge(&rows, &area, l.0, l.1);
+        }
     }
     Ok(filled_hulls(&rows, w, h))
 }
+
+/// [`convex_hulls_joined`] joins nothing where more pairs of components than this are
+/// within its gap: a mask of that many close specks is texture or noise, not the arcs of a
+/// few rims, and judging every pair again after each join would grow with their square.
+pub const MAX_LINKS: usize = 256;
 
 /// How [`convex_hulls_joined`] joins components.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -763,6 +791,22 @@ mod tests {
             ..rim
         };
         assert!(convex_hulls_joined(&m, w, h, &uncapped).unwrap()[20 * w + 32]);
+    }
+
+    /// A 256x256 mask of 4,096 specks (2x2 pixels, 2 apart), each pair of neighbours
+    /// outlining its joint hull: more linked pairs than [`MAX_LINKS`], so one hull each.
+    #[test]
+    fn a_mask_of_many_close_specks_joins_nothing() {
+        let (w, h) = (256, 256);
+        let m: Vec<bool> = (0..w * h)
+            .map(|k| (k % w) % 4 < 2 && (k / w) % 4 < 2)
+            .collect();
+        let joined = convex_hulls_joined(&m, w, h, &ArcJoin::rim_arcs(w, h, 2)).unwrap();
+        assert_eq!(joined, convex_hull_objects(&m, w, h).unwrap());
+        assert!(
+            !joined[2 * w + 2],
+            "the spaces between the specks stay empty"
+        );
     }
 
     /// The run-distance closing-opening equals the grey-scale one exactly, on
