@@ -30,10 +30,10 @@ pub enum Connectivity {
 const STRIPE_ROWS: usize = 64;
 
 /// Union-find over provisional labels; the root of a set is its smallest label.
-struct Forest(Vec<u32>);
+pub(crate) struct Forest(pub(crate) Vec<u32>);
 
 impl Forest {
-    fn find(&mut self, mut a: u32) -> u32 {
+    pub(crate) fn find(&mut self, mut a: u32) -> u32 {
         while self.0[a as usize] != a {
             let up = self.0[self.0[a as usize] as usize];
             self.0[a as usize] = up;
@@ -42,7 +42,7 @@ impl Forest {
         a
     }
 
-    fn union(&mut self, a: u32, b: u32) -> u32 {
+    pub(crate) fn union(&mut self, a: u32, b: u32) -> u32 {
         let (ra, rb) = (self.find(a), self.find(b));
         let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
         self.0[hi as usize] = lo;

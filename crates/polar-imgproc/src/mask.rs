@@ -3,6 +3,7 @@
 //! splitting at narrow necks, convex hulls per component or over the arcs of one broken
 //! outline; the clean-up the segmenting tasks (material regions, transparency masks) share.
 
+use crate::label::Forest;
 use crate::morph::{check_kernel, runs};
 use crate::{Connectivity, MorphShape, close, label, max_filter, open};
 use polar_image::Gray;
@@ -338,8 +339,12 @@ pub fn convex_hulls_joined(
         // single pixels over 32 megapixels); one hull per component.
         return convex_hull_objects(m, w, h);
     }
-    let near = grown(m, w, h, join.near)?;
     let mut rows = row_extremes(&lab, n, w, h);
+    let pairs = neighbour_pairs(&lab, n, w, h, join.gap)?;
+    if pairs.is_empty() || pairs.len() > MAX_LINKS {
+        return Ok(filled_hulls(&rows, w, h));
+    }
+    let near = grown(m, w, h, join.near)?;
     let mut area = vec![0usize; n + 1];
     lab.iter().for_each(|&l| area[l as usize] += 1);
     // The coverage of the joint hull of the sets whose roots are `a` and `b`, where it
@@ -352,19 +357,9 @@ pub fn convex_hulls_joined(
         let coverage = outline_coverage(&runs, &near, w);
         (fill <= join.max_fill && coverage >= join.min_coverage).then_some(coverage)
     };
-    // Union-find over the labels `1..=n`; a set's row extremes and area move to its root.
-    // The linked pairs of roots keep their judgement until one of them is joined.
-    let mut root: Vec<usize> = (0..=n).collect();
-    let find = |root: &[usize], mut c: usize| {
-        while root[c] != c {
-            c = root[c];
-        }
-        c
-    };
-    let pairs = neighbour_pairs(&lab, n, w, h, join.gap)?;
-    if pairs.len() > MAX_LINKS {
-        return Ok(filled_hulls(&rows, w, h));
-    }
+    // Sets of labels (the root the smallest); a set's row extremes and area move to its
+    // root. The linked pairs of roots keep their judgement until one of them is joined.
+    let mut sets = Forest((0..=n as u32).collect());
     let mut links: Vec<(usize, usize, Option<f32>)> = (pairs.into_iter())
         .map(|(a, b)| (a, b, judge(&rows, &area, a, b)))
         .collect();
@@ -372,12 +367,18 @@ pub fn convex_hulls_joined(
         .filter_map(|&(x, y, c)| c.map(|c| (c, x, y)))
         .max_by(|p, q| p.0.total_cmp(&q.0))
     {
-        root[b] = a;
+        sets.union(a as u32, b as u32);
         let moved = std::mem::take(&mut rows[b - 1]);
         rows[a - 1].extend(moved);
         area[a] += area[b];
         links = (links.into_iter())
-            .map(|(x, y, c)| (find(&root, x), find(&root, y), c))
+            .map(|(x, y, c)| {
+                (
+                    sets.find(x as u32) as usize,
+                    sets.find(y as u32) as usize,
+                    c,
+                )
+            })
             .filter(|(x, y, _)| x != y)
             .map(|(x, y, c)| (x.min(y), x.max(y), c))
             .collect();
