@@ -34,10 +34,10 @@
 //!    demosaicing residue), up to `Σg²⁻¹·(Σg)²` where it is one smooth field (an object).
 //!    Regions are `z` above Otsu's threshold of `z`, opened by 3×3, without components
 //!    smaller than the window (`π (2σ)²` pixels) and without those polarized no more
-//!    than the background and without an occluding-contour signature (`object_like`):
-//!    a floor's AoLP can be coherent where its DoLP is only noise and demosaicing
-//!    residue, and where the objects are few and small Otsu's threshold falls inside
-//!    that floor's coherence;
+//!    than the background and without an occluding-contour signature, or reaching the
+//!    frame's border (`object_like`): a floor's AoLP can be coherent where its DoLP is
+//!    only noise and demosaicing residue, and where the objects are few and small
+//!    Otsu's threshold falls inside that floor's coherence;
 //! 2. holes are filled unless an occluding contour bounds them: the diffuse DoLP peaks
 //!    at grazing, so around a hole seen through an object (a torus) the DoLP is highest
 //!    next to the hole, while around a patch facing the camera (low DoLP) it rises away
@@ -678,9 +678,13 @@ fn coherent_with_holes(cues: &Cues) -> Result<Coherent, ShapeError> {
 /// The components of cue B's `regions` that are an object's: polarized above the
 /// background (their [`DOLP_QUANTILE`] of the DoLP above [`COHERENT_DOLP_FACTOR`] times that
 /// of the valid pixels outside them, at least [`MIN_BACKGROUND_DOLP`]; a quantile above
-/// the median, as an object is polarized mostly toward its rim), or with the
-/// occluding-contour signature along their boundary ([`has_contour`]: a smooth metal is
-/// polarized no more than the floor, but across its silhouette's normal).
+/// the median, as an object is polarized mostly toward its rim), or inside the frame with
+/// the occluding-contour signature along their boundary ([`has_contour`]: a smooth metal is
+/// polarized no more than the floor, but across its silhouette's normal). A region that
+/// reaches the frame's border polarized no more than the background is background: a
+/// floor seen obliquely is weakly polarized along one angle, and its boundary shows the
+/// signature wherever it runs along or across that angle (the edge of an object lying on
+/// it, a tile's edge).
 fn object_like(cues: &Cues, regions: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let (id, n) = components(&regions, w, h)?;
@@ -694,6 +698,7 @@ fn object_like(cues: &Cues, regions: Vec<bool>) -> Result<Vec<bool>, ShapeError>
         dolp[id[k] as usize].push(cues.dolp[k]);
     }
     let contour = contour_sums(cues, &regions, &id, n)?;
+    let at_border = touching_border(&id, n, w, h);
     let keep: Vec<bool> = dolp
         .into_iter()
         .enumerate()
@@ -701,7 +706,7 @@ fn object_like(cues: &Cues, regions: Vec<bool>) -> Result<Vec<bool>, ShapeError>
             let [cos, weight, weight_sq] = contour[c];
             c > 0
                 && (quantile(d, DOLP_QUANTILE).is_some_and(|q| q > bar)
-                    || has_contour(cos, weight, weight_sq))
+                    || (!at_border[c] && has_contour(cos, weight, weight_sq)))
         })
         .collect();
     Ok(id.iter().map(|&i| keep[i as usize]).collect())
@@ -863,15 +868,22 @@ fn inner_or_with_contour(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeErro
         return Ok(m.to_vec());
     }
     let sums = contour_sums(cues, m, &id, n)?;
-    let mut at_border = vec![false; n + 1];
-    for k in (0..w * h).filter(|&k| m[k]) {
-        let (x, y) = (k % w, k / w);
-        at_border[id[k] as usize] |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
-    }
+    let at_border = touching_border(&id, n, w, h);
     let keep: Vec<bool> = (0..=n)
         .map(|c| !at_border[c] || has_contour(sums[c][0], sums[c][1], sums[c][2]))
         .collect();
     Ok((0..w * h).map(|k| m[k] && keep[id[k] as usize]).collect())
+}
+
+/// Per label of `id` (`n` labels, 0 = none), whether one of its pixels lies on the frame's
+/// border.
+fn touching_border(id: &[u32], n: usize, w: usize, h: usize) -> Vec<bool> {
+    let mut at_border = vec![false; n + 1];
+    for (k, &i) in id.iter().enumerate().filter(|(_, i)| **i > 0) {
+        let (x, y) = (k % w, k / w);
+        at_border[i as usize] |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+    }
+    at_border
 }
 
 /// Per label of `id` (`n` labels over the pixels of `m`), the sums [`has_contour`] tests

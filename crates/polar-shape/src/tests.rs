@@ -854,6 +854,29 @@ fn coherent_floor_reaching_the_border_is_not_foreground() {
     assert!(iou > 0.8, "sphere IoU {iou}");
 }
 
+/// A floor band along the bottom edge polarized at the noise level (DoLP 0.012) along one
+/// angle, 0°, which its horizontal boundary runs perpendicular to: the boundary shows the
+/// occluding contour's `cos 4Δ` signature, as a floor seen obliquely does along the
+/// straight edge of an object lying on it. Reaching the frame's border and polarized no
+/// more than the background, it is background; the sphere stays.
+#[test]
+fn weak_floor_at_the_border_is_background_though_its_edge_shows_the_signature() {
+    let (mut scene, truth) = left_sphere();
+    add_polarization_noise(&mut scene, 0.02);
+    let floor = |k: usize| k / 96 >= 80;
+    for (k, st) in scene.stokes.iter_mut().enumerate() {
+        if floor(k) {
+            st[1] = 0.012 * st[0];
+            st[2] = 0.0;
+        }
+    }
+    let fg = coherent_foreground(&scene);
+    let taken = (0..fg.len()).filter(|&k| fg[k] && floor(k)).count();
+    assert_eq!(taken, 0, "the weakly polarized floor taken as foreground");
+    let iou = mask_iou(&fg, &truth);
+    assert!(iou > 0.8, "sphere IoU {iou}");
+}
+
 /// An annulus with the normal field of a torus facing the camera (tube radius `r`
 /// around a circle of radius `big_r`, both in units of the image-plane slope `d.xy/−d.z`),
 /// diffuse, on an unpolarized background, with polarization noise up to `noise`.
