@@ -5,7 +5,9 @@
 
 use crate::label::Forest;
 use crate::morph::{check_kernel, runs};
-use crate::{Connectivity, MorphShape, close, label, max_filter, open};
+use crate::{
+    Connectivity, MorphShape, Outside, close, distance_to_background, label, max_filter, open,
+};
 use polar_image::Gray;
 
 use crate::Error;
@@ -236,6 +238,39 @@ impl Flood {
         (labels, count)
     }
 }
+
+/// `m` cut into its blobs ([`split_at_necks`] on the Euclidean distance to the outside,
+/// the frame's edge counting as outside), the pixels where two blobs meet left out, so that
+/// each blob is an 8-connected component of its own: two objects whose masks touch through
+/// a narrow bridge (a shared shadow, a strip of floor, a glint between them) take a convex
+/// hull each. A neck cuts where it is narrower than [`BLOB_NECK`] of the smaller blob's
+/// inscribed radius and both radii reach [`BLOB_RADIUS`] of the frame's shorter side (the
+/// thinner arcs of one rim stay together).
+pub fn blobs_apart(m: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
+    let dist: Vec<f32> = distance_to_background(m, w, h, Outside::Background)
+        .into_iter()
+        .map(|d| d as f32)
+        .collect();
+    let min_peak = BLOB_RADIUS * w.min(h) as f32;
+    let (blob, _) = split_at_necks(m, &dist, w, h, BLOB_NECK, min_peak)?;
+    Ok((0..w * h)
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            let alone = |a: usize, b: usize| [0, blob[k]].contains(&blob[b * w + a]);
+            blob[k] != 0
+                && (y.saturating_sub(1)..=(y + 1).min(h - 1))
+                    .all(|b| (x.saturating_sub(1)..=(x + 1).min(w - 1)).all(|a| alone(a, b)))
+        })
+        .collect())
+}
+
+/// The neck ratio of [`blobs_apart`]: a bridge narrower than this share of the smaller
+/// blob's inscribed radius joins two objects, not two parts of one.
+pub const BLOB_NECK: f32 = 0.3;
+
+/// The least inscribed radius of a blob [`blobs_apart`] cuts off, as a share of the frame's
+/// shorter side.
+pub const BLOB_RADIUS: f32 = 0.05;
 
 /// Fills holes: components of the complement (4-connected) that do not touch the border.
 pub fn fill_holes(m: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
@@ -650,6 +685,23 @@ mod tests {
                 "{x1} {half}"
             );
         }
+    }
+
+    /// Two discs joined by a 3-pixel bridge come apart as two components, nothing lost but
+    /// the pixels where they meet (the bridge's two columns either side of the cut); a disc
+    /// alone stays whole.
+    #[test]
+    fn blobs_apart_cuts_the_bridge_and_keeps_a_disc_whole() {
+        let (w, h) = (64, 32);
+        let (m, _) = two_discs(16.0, 46.0, 10.0, 1);
+        let apart = blobs_apart(&m, w, h).unwrap();
+        assert_eq!(components(&m, w, h).unwrap().1, 1);
+        assert_eq!(components(&apart, w, h).unwrap().1, 2);
+        assert!((0..w * h).all(|k| !apart[k] || m[k]));
+        let lost = (0..w * h).filter(|&k| m[k] && !apart[k]).count();
+        assert!(lost <= 6, "{lost} pixels left out");
+        let (one, _) = two_discs(16.0, 16.0, 10.0, 0);
+        assert_eq!(blobs_apart(&one, w, h).unwrap(), one);
     }
 
     /// A distance plane of the wrong size or a non-finite distance on the mask is an

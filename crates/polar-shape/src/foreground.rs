@@ -78,10 +78,10 @@ use std::collections::VecDeque;
 use std::ops::RangeInclusive;
 
 use polar_image::{Gray, quantile};
-use polar_imgproc::mask::{components, fill_holes, remove_small, split_at_necks};
+use polar_imgproc::mask::{components, fill_holes, remove_small};
 use polar_imgproc::{
-    Border, MorphShape, Outside, dilate, distance_to_background, erode, gaussian_blur,
-    gaussian_kernel, open, sep_filter, sobel, threshold_otsu,
+    Border, MorphShape, dilate, erode, gaussian_blur, gaussian_kernel, open, sep_filter, sobel,
+    threshold_otsu,
 };
 
 use rayon::prelude::*;
@@ -153,13 +153,6 @@ const MIN_BACKGROUND_DOLP: f32 = 0.01;
 const COHERENT_DOLP_FACTOR: f32 = 1.2;
 /// The quantile of the DoLP that [`COHERENT_DOLP_FACTOR`] compares.
 const DOLP_QUANTILE: f64 = 0.75;
-/// Two objects whose regions touch through a bridge narrower than this share of the
-/// smaller one's inscribed radius (a shared shadow, a strip of floor) get a convex hull
-/// each in [`fill_hull_gaps`]: the floor seen between them is a gap of neither.
-const HULL_NECK: f32 = 0.3;
-/// ... where both inscribed radii reach this share of the image's shorter side: the
-/// thinner arcs of one object's rim stay together, and their hull is its face.
-const HULL_BLOB: f32 = 0.05;
 /// Blobs a short way apart share one hull in [`fill_hull_gaps`] where their joint hull's
 /// outline runs within this many pixels of them and they leave part of it empty
 /// ([`polar_imgproc::mask::ArcJoin::rim_arcs`]): the arcs of one rim, broken where the
@@ -494,26 +487,11 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
     Ok((0..w * h).map(|k| fg[k] || fill[id[k] as usize]).collect())
 }
 
-/// The union of the convex hulls of `fg`'s blobs: its components cut at narrow necks
-/// ([`HULL_NECK`], [`HULL_BLOB`]; inscribed radii as the material rule's, the frame's
-/// edge counting as background), the pixels where two blobs meet left out, blobs that are
-/// the arcs of one rim under one hull ([`ARC_NEAR`]).
+/// The union of the convex hulls of `fg`'s blobs ([`polar_imgproc::mask::blobs_apart`]: the
+/// floor seen between two objects whose regions touch through a shared shadow is a gap of
+/// neither), blobs that are the arcs of one rim under one hull ([`ARC_NEAR`]).
 fn hull_per_blob(fg: &[bool], w: usize, h: usize) -> Result<Vec<bool>, ShapeError> {
-    let dist: Vec<f32> = distance_to_background(fg, w, h, Outside::Background)
-        .into_iter()
-        .map(|d| d as f32)
-        .collect();
-    let min_peak = HULL_BLOB * w.min(h) as f32;
-    let (blob, _) = split_at_necks(fg, &dist, w, h, HULL_NECK, min_peak)?;
-    let apart: Vec<bool> = (0..w * h)
-        .map(|k| {
-            let (x, y) = (k % w, k / w);
-            let alone = |a: usize, b: usize| [0, blob[k]].contains(&blob[b * w + a]);
-            blob[k] != 0
-                && (y.saturating_sub(1)..=(y + 1).min(h - 1))
-                    .all(|b| (x.saturating_sub(1)..=(x + 1).min(w - 1)).all(|a| alone(a, b)))
-        })
-        .collect();
+    let apart = polar_imgproc::mask::blobs_apart(fg, w, h)?;
     let join = polar_imgproc::mask::ArcJoin::rim_arcs(w, h, ARC_NEAR);
     Ok(polar_imgproc::mask::convex_hulls_joined(
         &apart, w, h, &join,

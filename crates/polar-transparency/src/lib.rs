@@ -281,16 +281,19 @@ fn border_from_inside(seed: Vec<bool>, w: usize, h: usize) -> Vec<bool> {
     (0..w * h).map(|k| seed[inner(k)]).collect()
 }
 
-/// The convex hulls of `mask`'s components that are not darker than their surroundings
+/// The convex hulls of the blobs ([`polar_imgproc::mask::blobs_apart`]: glass and an opaque
+/// object side by side, their masks touching through a glint or a polarized strip of floor,
+/// take one each) of `mask`'s components that are not darker than their surroundings
 /// ([`without_dark_regions`], judged on each component's own hull: joined first, a dark
-/// glossy object would share a hull with the lit specks around it), components
-/// close enough sharing one ([`polar_imgproc::mask::ArcJoin::rim_arcs`]): a glass
-/// ball's or ring's rim is polarized in arcs, cut where reflection (polarized across the
-/// plane of incidence) and transmission (along it) cancel and where neither is strong.
+/// glossy object would share a hull with the lit specks around it), blobs close enough
+/// sharing one ([`polar_imgproc::mask::ArcJoin::rim_arcs`]): a glass ball's or ring's rim
+/// is polarized in arcs, cut where reflection (polarized across the plane of incidence) and
+/// transmission (along it) cancel and where neither is strong.
 fn lit_hulls(obs: &Observation, mask: Vec<bool>) -> Result<Vec<bool>, TransparencyError> {
     let (w, h) = obs.size();
     let lit = without_dark_regions(obs, polar_imgproc::mask::convex_hull_objects(&mask, w, h)?)?;
     let seeds: Vec<bool> = mask.iter().zip(&lit).map(|(&s, &l)| s && l).collect();
+    let seeds = polar_imgproc::mask::blobs_apart(&seeds, w, h)?;
     let join = polar_imgproc::mask::ArcJoin::rim_arcs(w, h, cues::WINDOW / 2);
     Ok(polar_imgproc::mask::convex_hulls_joined(
         &seeds, w, h, &join,

@@ -196,6 +196,26 @@ fn glass_discs_side_by_side_stay_apart() {
     assert!((30..66).all(|y| !on(48, y)), "nothing between them");
 }
 
+/// The same two discs joined by a polarized strip three pixels high (a glint on the floor
+/// between them): one component, whose single hull would take in the checkerboard above
+/// and below the strip; cut at the strip, a neck far narrower than either disc, each disc
+/// keeps its own hull.
+#[test]
+fn glass_discs_joined_by_a_polarized_strip_keep_their_own_hulls() {
+    let obs = observation(|x, y| {
+        match disc_at(25.0, 48.0, 17.0, x, y).or_else(|| disc_at(71.0, 48.0, 17.0, x, y)) {
+            Some((ze, az)) => (0.9 * checker(x, y), 2.0 * transmitted_dolp(ze, 1.5), az),
+            None if (47..50).contains(&y) && (38..59).contains(&x) => (checker(x, y), 0.3, 0.0),
+            None => (checker(x, y), 0.0, 0.0),
+        }
+    });
+    let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
+    let on = |x: usize, y: usize| out.mask.as_slice()[y * N + x] == ON;
+    assert!(on(25, 48) && on(71, 48), "both discs found");
+    let between = (30..42).chain(56..66).filter(|&y| on(48, y)).count();
+    assert_eq!(between, 0, "the checkerboard between the discs taken in");
+}
+
 /// Score maps with three levels: a background over most of the frame, weakly polarized
 /// glass, and more strongly polarized glass covering more pixels than the weak one, so that
 /// Otsu's threshold falls between the two glasses. On a clean background the threshold is
