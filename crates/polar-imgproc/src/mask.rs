@@ -247,6 +247,9 @@ impl Flood {
 /// inscribed radius and both radii reach [`BLOB_RADIUS`] of the frame's shorter side (the
 /// thinner arcs of one rim stay together).
 pub fn blobs_apart(m: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
+    if m.len() != w * h {
+        return Err(Error::SizeMismatch(w, h, m.len(), 1));
+    }
     let dist: Vec<f32> = distance_to_background(m, w, h, Outside::Background)
         .into_iter()
         .map(|d| d as f32)
@@ -742,6 +745,11 @@ mod tests {
         assert!(lost <= 6, "{lost} pixels left out");
         let (one, _) = two_discs(16.0, 16.0, 10.0, 0);
         assert_eq!(blobs_apart(&one, w, h).unwrap(), one);
+        assert!(matches!(
+            blobs_apart(&one[1..], w, h),
+            Err(Error::SizeMismatch(..))
+        ));
+        assert_eq!(blobs_apart(&[], 0, 0).unwrap(), Vec::<bool>::new());
     }
 
     /// Skipping the split where no component holds two peaks changes nothing: on discs
