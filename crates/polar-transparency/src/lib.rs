@@ -362,7 +362,7 @@ fn without_depolarized_rim(
 /// object, polarized as strongly, returns only its surface reflection: regions darker
 /// than this share of their surroundings' median S0 are dropped. Below a half, to leave
 /// room for glass over the darker parts of a backdrop and for its refracted view.
-pub const SEE_THROUGH: f32 = 0.4;
+pub const SEE_THROUGH: f32 = 0.45;
 /// Width (pixels) of the ring whose brightness [`without_dark_regions`] compares.
 const RING: usize = 10;
 

@@ -12,8 +12,8 @@ use polar_optics::pixel_frame::CameraModel;
 use polar_sensor::{Observation, StokesPlanes};
 use polar_transparency::knn::{self, BUILTIN_MODEL, EXPECT, KnnClassifier};
 use polar_transparency::{
-    MIN_THRESHOLD, MIN_WINDOWS, NOISE_FLOOR_CAP, ON, Segmenter, TransparencyOptions, cue_threshold,
-    detect,
+    MIN_THRESHOLD, MIN_WINDOWS, NOISE_FLOOR_CAP, ON, SEE_THROUGH, Segmenter, TransparencyOptions,
+    cue_threshold, detect,
 };
 use std::f64::consts::FRAC_PI_2;
 
@@ -140,6 +140,23 @@ fn dark_glossy_opaque_disc_is_no_glass() {
         let iou = iou_with_disc(&out.mask);
         assert_eq!(iou > 0.8, glass, "brightness {brightness}: IoU {iou}");
     }
+}
+
+/// The darkness test's bar, [`SEE_THROUGH`] of the surroundings' median brightness (a plain
+/// backdrop, so that the median is one value): a glossy disc at 0.43 of it is no glass,
+/// one at 0.55 is.
+#[test]
+fn disc_just_below_the_see_through_share_is_no_glass() {
+    for (ratio, glass) in [(0.43, false), (0.55, true)] {
+        let obs = observation(|x, y| match disc(x, y) {
+            Some((ze, az)) => (ratio * 0.5, (2.0 * transmitted_dolp(ze, 1.5)).min(1.0), az),
+            None => (0.5, 0.0, 0.0),
+        });
+        let out = detect(&obs, &Segmenter::Cues, &TransparencyOptions::default()).unwrap();
+        let iou = iou_with_disc(&out.mask);
+        assert_eq!(iou > 0.8, glass, "ratio {ratio}: IoU {iou}");
+    }
+    assert!(SEE_THROUGH > 0.43 && SEE_THROUGH < 0.55);
 }
 
 /// Glass lit so that only part of its rim is polarized: reflection of a bright window on
