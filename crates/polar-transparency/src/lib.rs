@@ -12,7 +12,8 @@
 //! background's level and by the noise's; or a given threshold), lets the seeds along the
 //! frame's edge follow their neighbours inside ([`BORDER`]), closes and opens the mask,
 //! fills holes (background components not touching the border), drops specks, replaces
-//! each component by its convex hull (arcs of one rim by one hull) and trims
+//! each blob (components cut at narrow necks) by its convex hull (arcs of one rim by one
+//! hull) and trims
 //! the depolarized rim that the window added around it, all with polar-imgproc. The hull is
 //! there because glass is polarized mostly along its rims and edges (reflection and
 //! transmission both grow toward grazing) and little where it faces the camera, so the
