@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use polar_image::{Gray, Image, StokesImage};
+use polar_image::{Gray, StokesImage};
 use polar_io::{BitDepth, MosaicPng};
 use polar_render::{Polarization, RenderOptions, RenderOutput, Scene};
 use polar_sensor::SensorModel;
@@ -256,23 +256,22 @@ pub fn dolp_aolp(stokes: &StokesImage) -> (Gray<f32>, Gray<f32>) {
 pub fn write_pictures(dir: &Path, stokes: &StokesImage) -> Result<(), Error> {
     use polar_image::quantile;
     use polar_io::files::vision;
-    use polar_sensor::picture::{aolp_hsv, colormap};
+    use polar_sensor::picture::{aolp_hsv, colormap_indices, viridis_palette};
     std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
     let s0 = stokes.channel(0);
     let top = quantile(s0.as_slice().iter().copied(), EXPOSURE_QUANTILE)
         .unwrap_or(1.0)
         .max(f32::MIN_POSITIVE);
     let (dolp, aolp) = dolp_aolp(stokes);
-    let pictures: [(&str, Image<u8, 3>); 3] = [
-        (vision::S0_PICTURE, colormap(&s0, 0.0, top)),
-        (vision::DOLP_PICTURE, colormap(&dolp, 0.0, 1.0)),
-        (vision::AOLP_PICTURE, aolp_hsv(&aolp, &dolp)),
-    ];
-    for (name, picture) in pictures {
-        polar_io::write_rgb8_png(dir.join(name), &picture)
-            .map_err(io_err(polar_io::files::vision::PICTURES))?;
+    let err = io_err(polar_io::files::vision::PICTURES);
+    for (name, values, top) in [
+        (vision::S0_PICTURE, &s0, top),
+        (vision::DOLP_PICTURE, &dolp, 1.0),
+    ] {
+        let indices = colormap_indices(values, 0.0, top);
+        polar_io::write_indexed8_png(dir.join(name), &indices, viridis_palette()).map_err(&err)?;
     }
-    Ok(())
+    polar_io::write_rgb8_png(dir.join(vision::AOLP_PICTURE), &aolp_hsv(&aolp, &dolp)).map_err(err)
 }
 
 #[cfg(test)]

@@ -68,6 +68,14 @@ pub enum Error {
         /// What the reader accepts.
         expected: &'static str,
     },
+    /// A palette image was asked for with no colours or more than 256.
+    #[error("{path}: a palette of {entries} colours; a PNG palette holds 1 to 256")]
+    Palette {
+        /// The file.
+        path: PathBuf,
+        /// The colours given.
+        entries: usize,
+    },
     /// The image has a bit depth this reader does not accept.
     #[error("{path}: bit depth {found}, expected {expected}")]
     BitDepth {

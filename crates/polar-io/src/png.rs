@@ -1,6 +1,7 @@
 //! Grayscale (8/16-bit) and RGB (8-bit) PNG through the `png` crate (the `image` crate's codec,
 //! used directly because `image` silently rescales 1/2/4-bit files to 8 bits).
-//! Mosaics, label maps and masks are grayscale; RGB is for visualisations only.
+//! Mosaics, label maps and masks are grayscale; RGB and 8-bit palette images (read back as
+//! RGB) are for visualisations only.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Seek, Write};
@@ -140,18 +141,34 @@ pub fn check_mosaic_size(path: &Path, width: usize, height: usize) -> Result<()>
     }
 }
 
-/// Reads an 8-bit RGB PNG (no alpha, no palette).
+/// Reads an 8-bit RGB PNG (no alpha), or an 8-bit palette PNG as the RGB of its palette (an
+/// index beyond the palette: [`Error::Corrupt`]).
 pub fn read_rgb8_png(path: impl AsRef<Path>) -> Result<Image<u8, 3>> {
     let path = path.as_ref();
-    let accept = |color, depth| {
-        if (color, depth) == (png::ColorType::Rgb, png::BitDepth::Eight) {
-            Ok(())
-        } else {
-            Err(color_error(path, color, depth, "Rgb, 8-bit"))
-        }
+    let accept = |color, depth| match (color, depth) {
+        (png::ColorType::Rgb | png::ColorType::Indexed, png::BitDepth::Eight) => Ok(()),
+        _ => Err(color_error(path, color, depth, "Rgb or Indexed, 8-bit")),
     };
     let d = decode(path, open(path)?, accept)?;
-    Image::from_vec(d.size.0, d.size.1, d.bytes).map_err(|e| Error::corrupt(path, "PNG", e))
+    let bytes = match &d.palette {
+        None => d.bytes,
+        Some(palette) => expand_palette(path, &d.bytes, palette)?,
+    };
+    Image::from_vec(d.size.0, d.size.1, bytes).map_err(|e| Error::corrupt(path, "PNG", e))
+}
+
+/// The RGB bytes of palette `indices` (`palette` as stored: three bytes an entry).
+fn expand_palette(path: &Path, indices: &[u8], palette: &[u8]) -> Result<Vec<u8>> {
+    let entries = palette.as_chunks::<3>().0;
+    let mut rgb = Vec::with_capacity(3 * indices.len());
+    for &i in indices {
+        let entry = entries.get(usize::from(i)).ok_or_else(|| {
+            let why = format!("palette index {i} beyond its {} entries", entries.len());
+            Error::corrupt(path, "PNG", why)
+        })?;
+        rgb.extend_from_slice(entry);
+    }
+    Ok(rgb)
 }
 
 /// Writes an 8-bit grayscale PNG, atomically.
@@ -211,6 +228,43 @@ pub fn write_rgb8_png_rows(
 ) -> Result<()> {
     let layout = Layout::new(size, png::ColorType::Rgb, png::BitDepth::Eight);
     encode(path.as_ref(), layout, fill)
+}
+
+/// Writes `indices` as an 8-bit palette PNG of `palette`, atomically (see
+/// [`write_indexed8_png_rows`]).
+pub fn write_indexed8_png<K>(
+    path: impl AsRef<Path>,
+    indices: &Image<u8, 1, K>,
+    palette: &[[u8; 3]],
+) -> Result<()> {
+    let bytes = indices.as_slice();
+    write_indexed8_png_rows(path, indices.size(), palette, |y, rows| {
+        rows.copy_from_slice(&bytes[y * indices.width()..][..rows.len()]);
+    })
+}
+
+/// Writes an 8-bit palette PNG whose indices `fill(y, rows)` computes a block of rows at a
+/// time (as [`write_rgb8_png_rows`]), atomically: a third of the bytes of the same picture
+/// in RGB to filter and deflate. `palette` holds 1 to 256 colours (else
+/// [`Error::Palette`]); every index written must name one.
+pub fn write_indexed8_png_rows(
+    path: impl AsRef<Path>,
+    size: (usize, usize),
+    palette: &[[u8; 3]],
+    fill: impl FnMut(usize, &mut [u8]),
+) -> Result<()> {
+    let path = path.as_ref();
+    if !(1..=256).contains(&palette.len()) {
+        return Err(Error::Palette {
+            path: path.to_owned(),
+            entries: palette.len(),
+        });
+    }
+    let layout = Layout {
+        palette: Some(palette.as_flattened()),
+        ..Layout::new(size, png::ColorType::Indexed, png::BitDepth::Eight)
+    };
+    encode(path, layout, fill)
 }
 
 /// Rows per block handed to a row filler: enough to fill both cores, small beside the image.
@@ -284,10 +338,19 @@ fn decode(
         .next_frame(&mut bytes)
         .map_err(|e| decode_error(path, e))?;
     bytes.truncate(frame.buffer_size());
+    let palette = (frame.color_type == png::ColorType::Indexed).then(|| {
+        reader
+            .info()
+            .palette
+            .as_deref()
+            .unwrap_or_default()
+            .to_vec()
+    });
     Ok(Decoded {
         depth: frame.bit_depth,
         size: (frame.width as usize, frame.height as usize),
         bytes,
+        palette,
     })
 }
 
@@ -296,6 +359,8 @@ struct Decoded {
     depth: png::BitDepth,
     size: (usize, usize),
     bytes: Vec<u8>,
+    /// The PLTE chunk's bytes of a palette image (empty where it has none).
+    palette: Option<Vec<u8>>,
 }
 
 /// Maps a `png` decoding error: I/O keeps its kind, the rest is a corrupt file.
@@ -326,15 +391,17 @@ fn color_error(
 
 /// Size and sample format of an image being encoded.
 #[derive(Clone, Copy)]
-struct Layout {
+struct Layout<'a> {
     width: usize,
     height: usize,
     row_bytes: usize,
     color: png::ColorType,
     depth: png::BitDepth,
+    /// The PLTE chunk's bytes (three an entry) of a palette image.
+    palette: Option<&'a [u8]>,
 }
 
-impl Layout {
+impl Layout<'_> {
     fn new((width, height): (usize, usize), color: png::ColorType, depth: png::BitDepth) -> Self {
         let sample_bytes = if depth == png::BitDepth::Sixteen {
             2
@@ -348,6 +415,7 @@ impl Layout {
             row_bytes,
             color,
             depth,
+            palette: None,
         }
     }
 }
@@ -378,6 +446,9 @@ fn encode(path: &Path, layout: Layout, mut fill: impl FnMut(usize, &mut [u8])) -
         let mut encoder = png::Encoder::new(writer, w, h);
         encoder.set_color(layout.color);
         encoder.set_depth(layout.depth);
+        if let Some(palette) = layout.palette {
+            encoder.set_palette(palette);
+        }
         encoder.set_compression(png::Compression::Fast);
         let mut png_writer = encoder.write_header().map_err(encode_error)?;
         let mut stream = png_writer.stream_writer().map_err(encode_error)?;

@@ -58,9 +58,10 @@ pub mod files {
         pub const AOLP: &str = "aolp.exr";
         /// 8-bit RGB picture: hue = AoLP, value = DoLP (also in polar-datagen's `pictures/`).
         pub const AOLP_PICTURE: &str = "aolp.png";
-        /// 8-bit RGB picture: viridis DoLP (also in polar-datagen's `pictures/`).
+        /// 8-bit palette picture: viridis DoLP (also in polar-datagen's `pictures/`).
         pub const DOLP_PICTURE: &str = "dolp.png";
-        /// 8-bit RGB picture: viridis S0 (also in polar-datagen's `pictures/`).
+        /// 8-bit palette picture: viridis S0, RGB sRGB for a colour mosaic (also in
+        /// polar-datagen's `pictures/`).
         pub const S0_PICTURE: &str = "s0.png";
         /// 8-bit validity mask of a raw input: 0 valid, 1 saturated, 2 zero S0.
         pub const MASK: &str = "mask.png";

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use polar_image::{Gray, Image};
 use polar_io::{
     BitDepth, Error, GrayPng, MosaicPng, read_gray_png, read_gray8_png, read_mosaic, read_rgb8_png,
-    write_gray_png, write_gray8_png, write_gray16_png, write_rgb8_png, write_rgb8_png_rows,
+    write_gray_png, write_gray8_png, write_gray16_png, write_indexed8_png_rows, write_rgb8_png,
+    write_rgb8_png_rows,
 };
 
 fn ramp8(width: usize, height: usize) -> Gray<u8> {
@@ -134,6 +135,57 @@ fn rgb8_round_trip_is_exact() {
     let img = Image::<u8, 3>::from_vec(5, 3, data).unwrap();
     write_rgb8_png(&path, &img).unwrap();
     assert_eq!(read_rgb8_png(&path).unwrap(), img);
+}
+
+/// A palette image (indices streamed in blocks, every one of 256 entries used) reads back as
+/// the RGB of its palette, byte for byte.
+#[test]
+fn palette_image_reads_back_as_its_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("indexed.png");
+    let (w, h) = (16, 100);
+    let palette: Vec<[u8; 3]> = (0..=255u8)
+        .map(|i| [i, 255 - i, i.wrapping_mul(7)])
+        .collect();
+    let index = |k: usize| (k * 11 % 256) as u8;
+    write_indexed8_png_rows(&path, (w, h), &palette, |y, rows| {
+        rows.iter_mut()
+            .enumerate()
+            .for_each(|(i, b)| *b = index(y * w + i));
+    })
+    .unwrap();
+    let rgb = (0..w * h)
+        .flat_map(|k| palette[usize::from(index(k))])
+        .collect();
+    assert_eq!(
+        read_rgb8_png(&path).unwrap(),
+        Image::<u8, 3>::from_vec(w, h, rgb).unwrap()
+    );
+}
+
+/// No palette or one over 256 colours is refused before a file exists; an index that names
+/// no colour of the file's palette is a corrupt file, not a panic or a black pixel.
+#[test]
+fn palette_out_of_range_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("indexed.png");
+    for n in [0, 257] {
+        let err = write_indexed8_png_rows(&path, (2, 2), &vec![[0; 3]; n], |_, _| {}).unwrap_err();
+        assert!(
+            matches!(err, Error::Palette { entries, .. } if entries == n),
+            "{err}"
+        );
+        assert!(!path.exists());
+    }
+    write_indexed8_png_rows(&path, (2, 2), &[[1, 2, 3], [4, 5, 6]], |_, rows| {
+        rows.copy_from_slice(&[0, 1, 1, 2]);
+    })
+    .unwrap();
+    let err = read_rgb8_png(&path).unwrap_err();
+    assert!(
+        matches!(err, Error::Corrupt { .. }) && err.to_string().contains("palette index 2"),
+        "{err}"
+    );
 }
 
 /// Rows streamed in blocks (150 rows: whole blocks and a partial last one) arrive once

@@ -3,7 +3,9 @@
 //! - [`aolp_hsv`]: hue = AoLP, saturation = 1, value = DoLP, exactly as
 //!   polanalyser's `applyColorToAoLP(aolp, value=dolp)` (OpenCV hue `0..179`,
 //!   `COLOR_HSV2BGR`), but returned as RGB.
-//! - [`colormap`]: a scalar image through a viridis-like colour map.
+//! - [`colormap`]: a scalar image through a viridis-like colour map of [`VIRIDIS_LEVELS`]
+//!   colours; [`colormap_index_into`] gives the same picture as indices into
+//!   [`viridis_palette`], for a palette PNG a third the size of its RGB.
 //! - [`srgb_into`]: linear colour values (a colour sensor's S0) as sRGB.
 //!
 //! Undefined pixels (NaN) are black.
@@ -116,6 +118,24 @@ pub fn viridis(t: f32) -> [u8; 3] {
     [channel(0), channel(1), channel(2)]
 }
 
+/// Colours of the map in pictures: `[vmin, vmax]` is cut into this many levels (matplotlib's
+/// viridis is likewise a table, of 256), so that a picture fits an 8-bit palette with black
+/// for undefined pixels ([`viridis_palette`]).
+pub const VIRIDIS_LEVELS: usize = 255;
+
+/// The palette of viridis pictures: index 0 black (undefined pixels), index `1 + j` the colour
+/// [`viridis`]`(j / (VIRIDIS_LEVELS - 1))`.
+pub fn viridis_palette() -> &'static [[u8; 3]; VIRIDIS_LEVELS + 1] {
+    static PALETTE: std::sync::OnceLock<[[u8; 3]; VIRIDIS_LEVELS + 1]> = std::sync::OnceLock::new();
+    PALETTE.get_or_init(|| {
+        let top = (VIRIDIS_LEVELS - 1) as f32;
+        std::array::from_fn(|i| match i {
+            0 => [0; 3],
+            i => viridis((i - 1) as f32 / top),
+        })
+    })
+}
+
 /// `values` mapped linearly from `[vmin, vmax]` onto the colour map; NaN gives black.
 pub fn colormap(values: &Gray<f32>, vmin: f32, vmax: f32) -> Rgb8 {
     let mut out = Rgb8::new(values.width(), values.height());
@@ -126,20 +146,53 @@ pub fn colormap(values: &Gray<f32>, vmin: f32, vmax: f32) -> Rgb8 {
 /// [`colormap`] of a run of pixels (e.g. a block of rows streamed to a PNG encoder); `values`
 /// and `out` have one length (else a panic: a caller's bug).
 pub fn colormap_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [[u8; 3]]) {
-    let scale = if vmax > vmin {
-        1.0 / (vmax - vmin)
-    } else {
-        0.0
-    };
     assert_eq!(values.len(), out.len());
-    par_fill(out, |k| {
-        let v = values[k];
-        if v.is_finite() {
-            viridis((v - vmin) * scale)
+    let (palette, level) = (viridis_palette(), Levels::new(vmin, vmax));
+    par_fill(out, |k| palette[usize::from(level.index(values[k]))]);
+}
+
+/// [`colormap`] as indices into [`viridis_palette`].
+pub fn colormap_indices(values: &Gray<f32>, vmin: f32, vmax: f32) -> Gray<u8> {
+    let mut out = Gray::new(values.width(), values.height());
+    colormap_index_into(values.as_slice(), vmin, vmax, out.as_mut_slice());
+    out
+}
+
+/// [`colormap_into`] as indices into [`viridis_palette`].
+pub fn colormap_index_into(values: &[f32], vmin: f32, vmax: f32, out: &mut [u8]) {
+    assert_eq!(values.len(), out.len());
+    let level = Levels::new(vmin, vmax);
+    par_fill(out, |k| level.index(values[k]));
+}
+
+/// The linear map of `[vmin, vmax]` onto the palette's levels.
+#[derive(Clone, Copy)]
+struct Levels {
+    vmin: f32,
+    scale: f32,
+}
+
+impl Levels {
+    fn new(vmin: f32, vmax: f32) -> Self {
+        let scale = if vmax > vmin {
+            (VIRIDIS_LEVELS - 1) as f32 / (vmax - vmin)
         } else {
-            [0; 3]
+            0.0
+        };
+        Levels { vmin, scale }
+    }
+
+    /// Palette index of `v`: the nearest level (clamped to the range) plus one; 0 where `v`
+    /// is not finite. `trunc(x + 0.5)` rounds as [`viridis`] does.
+    #[inline]
+    fn index(self, v: f32) -> u8 {
+        if v.is_finite() {
+            let x = ((v - self.vmin) * self.scale).clamp(0.0, (VIRIDIS_LEVELS - 1) as f32);
+            1 + (x + 0.5) as u8
+        } else {
+            0
         }
-    });
+    }
 }
 
 /// Linear R, G, B values divided by `vmax`, clipped to `[0, 1]` and encoded with the sRGB
@@ -245,6 +298,49 @@ mod tests {
             let t = f32::from_bits(bits);
             assert_eq!(viridis(t), reference(t), "t {t}");
         }
+    }
+
+    /// The palette's levels sit at `vmin + j (vmax - vmin) / 254`: each maps to its own
+    /// index `1 + j`, a value within under half a step of it too; the range's ends clamp;
+    /// the RGB map is the palette at the index; undefined pixels take index 0, black.
+    #[test]
+    fn colormap_indices_are_the_palette_levels() {
+        let (vmin, vmax) = (-2.0f32, 3.0f32);
+        let step = (vmax - vmin) / (VIRIDIS_LEVELS - 1) as f32;
+        let mut values: Vec<f32> = (0..VIRIDIS_LEVELS)
+            .flat_map(|j| [0.0, 0.45, -0.45].map(|d| vmin + (j as f32 + d) * step))
+            .collect();
+        values.extend([
+            vmin - 1.0,
+            vmax + 1.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ]);
+        let mut index = vec![9u8; values.len()];
+        let mut rgb = vec![[9u8; 3]; values.len()];
+        colormap_index_into(&values, vmin, vmax, &mut index);
+        colormap_into(&values, vmin, vmax, &mut rgb);
+        for j in 0..VIRIDIS_LEVELS {
+            let at = (3 * j..3 * j + 3)
+                .filter(|&k| (0.0..=254.0).contains(&((values[k] - vmin) / step)));
+            for k in at {
+                assert_eq!(
+                    usize::from(index[k]),
+                    1 + j,
+                    "level {j}, value {}",
+                    values[k]
+                );
+            }
+        }
+        let n = values.len();
+        assert_eq!(index[n - 5..], [1, 255, 0, 0, 0]);
+        for (k, (&i, &c)) in index.iter().zip(&rgb).enumerate() {
+            assert_eq!(c, viridis_palette()[usize::from(i)], "value {}", values[k]);
+        }
+        assert_eq!(viridis_palette()[0], [0; 3]);
+        assert_eq!(viridis_palette()[1], viridis(0.0));
+        assert_eq!(viridis_palette()[VIRIDIS_LEVELS], viridis(1.0));
     }
 
     #[test]

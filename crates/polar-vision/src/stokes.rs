@@ -10,7 +10,7 @@ use polar_io::files::vision;
 use polar_io::{
     ExrCompression, LINEAR_STOKES_CHANNELS, RGB_CHANNELS, RGB_LINEAR_STOKES_CHANNELS, Y_CHANNEL,
 };
-use polar_sensor::picture::{aolp_hsv_into, colormap_into, srgb_into};
+use polar_sensor::picture::{aolp_hsv_into, colormap_index_into, srgb_into, viridis_palette};
 use polar_sensor::{ColorStokesPlanes, StokesPlanes};
 
 use crate::error::CliError;
@@ -217,10 +217,12 @@ fn push_pictures<'a>(jobs: &mut Writes<'a>, out: &'a Path, what: Planes<'a>) {
         })
     });
     jobs.push(vision::DOLP_PICTURE, move || {
-        polar_io::write_rgb8_png_rows(out.join(vision::DOLP_PICTURE), size, |y, bytes| {
-            let (px, k) = pixel_rows(size.0, y, bytes);
-            colormap_into(&planes.dolp.as_slice()[k], 0.0, 1.0, px);
-        })
+        viridis_png(
+            &out.join(vision::DOLP_PICTURE),
+            planes.dolp.as_slice(),
+            size,
+            1.0,
+        )
     });
     jobs.push(vision::S0_PICTURE, move || {
         let path = out.join(vision::S0_PICTURE);
@@ -237,13 +239,18 @@ fn push_pictures<'a>(jobs: &mut Writes<'a>, out: &'a Path, what: Planes<'a>) {
             None => {
                 let s0 = planes.s0.as_slice();
                 let s0_max = quantile(s0.iter().copied(), 0.995).unwrap_or(1.0);
-                polar_io::write_rgb8_png_rows(path, size, |y, bytes| {
-                    let (px, k) = pixel_rows(size.0, y, bytes);
-                    colormap_into(&s0[k], 0.0, s0_max, px);
-                })
+                viridis_png(&path, s0, size, s0_max)
             }
         }
     });
+}
+
+/// Writes `plane` (of `size`) from 0 to `top` on the viridis map, as a palette PNG.
+fn viridis_png(path: &Path, plane: &[f32], size: (usize, usize), top: f32) -> polar_io::Result<()> {
+    polar_io::write_indexed8_png_rows(path, size, viridis_palette(), |y, rows| {
+        let first = y * size.0;
+        colormap_index_into(&plane[first..first + rows.len()], 0.0, top, rows);
+    })
 }
 
 /// A block of RGB rows from row `y` on, as pixels, and the plane indices they show.

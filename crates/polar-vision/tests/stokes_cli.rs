@@ -7,7 +7,7 @@ use polar_image::Mosaic;
 use polar_image::quantile;
 use polar_io::RGB_LINEAR_STOKES_CHANNELS;
 use polar_io::files::{self, vision};
-use polar_sensor::picture::srgb_into;
+use polar_sensor::picture::{colormap, srgb_into};
 use polar_sensor::{DemosaicMethod, StokesPlanes, stokes_planes, stokes_planes_rgb};
 
 fn run(args: &[&str]) -> Output {
@@ -86,6 +86,15 @@ fn writes_every_output_and_matches_the_library() {
         assert_eq!(got, want.linear_stokes(), "{method}");
         let dolp = polar_io::read_exr_channel(out_dir.join(vision::DOLP), "Y").unwrap();
         assert_eq!(dolp.size(), want.dolp.size());
+        // The palette pictures read back as the library's viridis maps, pixel for pixel.
+        let s0_max = quantile(want.s0.as_slice().iter().copied(), 0.995).unwrap();
+        for (file, plane, top) in [
+            (vision::DOLP_PICTURE, &want.dolp, 1.0),
+            (vision::S0_PICTURE, &want.s0, s0_max),
+        ] {
+            let picture = polar_io::read_rgb8_png(out_dir.join(file)).unwrap();
+            assert_eq!(picture, colormap(plane, 0.0, top), "{method}: {file}");
+        }
     }
 }
 
