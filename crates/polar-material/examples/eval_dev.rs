@@ -1,7 +1,7 @@
 //! Evaluates material classification on the dev family: `materials-*` sample directories.
 //!
 //! ```text
-//! cargo run -p polar-material --release --example eval_dev -- [DATA_DIR] [--stokes]
+//! cargo run -p polar-material --release --example material_eval_dev -- [DATA_DIR] [--stokes]
 //! ```
 //! `DATA_DIR` defaults to `/work/data/dev`. `--stats` prints per ground-truth object the
 //! cue statistics instead; the environment variable `DUMP=dir` writes a picture per

@@ -3,7 +3,7 @@
 //! split by the sensor noise level, with timings, the foreground IoU against the object
 //! mask and a "full" mean that scores missed object pixels as facing the camera.
 //!
-//! `cargo run -p polar-shape --release --example eval_dev -- [DATASET] [--exr] [--debug DIR]
+//! `cargo run -p polar-shape --release --example sfp_eval_dev -- [DATASET] [--exr] [--debug DIR]
 //! [--only TEXT] [--no-speed] [--ior N|auto]` (default `/work/data/dev`; samples `sfp-*` and
 //! the Mitsuba task scenes `mts-shape-*`; `--only` keeps names containing TEXT, `--no-speed`
 //! skips the timing of upscaled frames, `--ior` as `polar-vision run --ior`, default 1.5,
@@ -70,7 +70,7 @@ fn args() -> Args {
             }
             "--help" | "-h" => {
                 println!(
-                    "eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto] [--oracle-fg] [--working-size N]"
+                    "sfp_eval_dev [DATASET] [--exr] [--debug DIR] [--only TEXT] [--no-speed] [--ior N|auto] [--oracle-fg] [--working-size N]"
                 );
                 std::process::exit(0);
             }

@@ -1,7 +1,7 @@
 //! Evaluates transparent-object detection on the dev set.
 //!
 //! ```text
-//! cargo run -p polar-transparency --release --example eval_dev -- [DATA_DIR] [--stokes] [-v]
+//! cargo run -p polar-transparency --release --example transparent_eval_dev -- [DATA_DIR] [--stokes] [-v]
 //!     [--model FILE|builtin] [--glass PREFIX] [--thresholds T,T,...]
 //! ```
 //! `DATA_DIR` defaults to `/work/data/dev`; `--model` uses the learned segmenter with that
