@@ -359,7 +359,7 @@ struct Decoded {
     depth: png::BitDepth,
     size: (usize, usize),
     bytes: Vec<u8>,
-    /// The PLTE chunk's bytes of a palette image (empty where it has none).
+    /// A palette image's PLTE bytes (empty if the file has none); `None` for other colour types.
     palette: Option<Vec<u8>>,
 }
 
