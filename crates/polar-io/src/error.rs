@@ -68,7 +68,7 @@ pub enum Error {
         /// What the reader accepts.
         expected: &'static str,
     },
-    /// A palette image was asked for with no colours or more than 256.
+    /// A PNG palette holds 1 to 256 colours; the one given does not.
     #[error("{path}: a palette of {entries} colours; a PNG palette holds 1 to 256")]
     Palette {
         /// The file.
