@@ -12,7 +12,7 @@ use crate::{BAND_ROWS, Border, Error, same_size};
 pub fn psnr(reference: &Gray<f32>, test: &Gray<f32>, data_range: f64) -> Result<f64, Error> {
     same_size(reference, test)?;
     check_range(data_range)?;
-    let sum: f64 = reference
+    let chunk_sums: Vec<f64> = reference
         .as_slice()
         .par_chunks(1 << 14)
         .zip(test.as_slice().par_chunks(1 << 14))
@@ -22,9 +22,16 @@ pub fn psnr(reference: &Gray<f32>, test: &Gray<f32>, data_range: f64) -> Result<
                 .map(|(x, y)| f64::from((x - y) * (x - y)))
                 .sum::<f64>()
         })
-        .sum();
+        .collect();
+    let sum = in_order(&chunk_sums);
     let mse = sum / reference.as_slice().len() as f64;
     Ok(10.0 * (data_range * data_range / mse).log10())
+}
+
+/// The sum of per-chunk partial sums, added in order: rayon's own `sum` associates them as
+/// its threads happen to split the work, so the last bits would vary from run to run.
+fn in_order(partial: &[f64]) -> f64 {
+    partial.iter().sum()
 }
 
 fn check_range(data_range: f64) -> Result<(), Error> {
@@ -165,7 +172,7 @@ fn ssim_impl(
         }
         sum
     };
-    let total: f64 = match map {
+    let band_sums: Vec<f64> = match map {
         Some(m) => m
             .as_mut_slice()
             .par_chunks_mut(w * BAND_ROWS)
@@ -174,15 +181,15 @@ fn ssim_impl(
                 let n = o.len() / w;
                 band(sc, i * BAND_ROWS, Some(o), n)
             })
-            .sum(),
+            .collect(),
         None => (0..h.div_ceil(BAND_ROWS))
             .into_par_iter()
             .map_init(Scratch::default, |sc, i| {
                 band(sc, i * BAND_ROWS, None, BAND_ROWS.min(h - i * BAND_ROWS))
             })
-            .sum(),
+            .collect(),
     };
-    Ok(total / ((w - 2 * r) * (h - 2 * r)) as f64)
+    Ok(in_order(&band_sums) / ((w - 2 * r) * (h - 2 * r)) as f64)
 }
 
 /// Summary of per-pixel angles between estimated and true normals, in degrees.
@@ -406,6 +413,36 @@ mod tests {
         assert!((ssim(&a, &a, 1.0).unwrap() - 1.0).abs() < 1e-6);
         assert_eq!(psnr(&a, &a, 1.0).unwrap(), f64::INFINITY);
         assert!(ssim(&Gray::new(10, 20), &Gray::new(10, 20), 1.0).is_err());
+    }
+
+    /// The sums behind PSNR and SSIM are bit-identical whatever the threads (the issue's
+    /// determinism across `--threads`): 40 runs in pools of 1 to 4 threads.
+    #[test]
+    fn psnr_and_ssim_do_not_depend_on_the_threads() {
+        let (w, h) = (640, 480);
+        let wave = |f: f32| -> Gray<f32> {
+            let v = (0..w * h)
+                .map(|i| (i as f32 * f).sin() * 0.5 + 0.5)
+                .collect();
+            Gray::from_vec(w, h, v).unwrap()
+        };
+        let (a, b) = (wave(0.0137), wave(0.0139));
+        let run = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| (psnr(&a, &b, 1.0).unwrap(), ssim(&a, &b, 1.0).unwrap()))
+        };
+        let first = run(1);
+        for k in 0..40 {
+            let (p, s) = run(1 + k % 4);
+            assert_eq!(
+                (p.to_bits(), s.to_bits()),
+                (first.0.to_bits(), first.1.to_bits()),
+                "run {k}"
+            );
+        }
     }
 
     #[test]
