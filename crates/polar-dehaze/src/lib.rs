@@ -19,6 +19,9 @@
 //! the dark channel as He et al., the polarization method regularised where `t` is near
 //! `t_min`, with `A_inf` varying over the frame where sky is seen).
 //!
+//! A frame in which the airlight found makes up little of the light on average is taken
+//! as haze-free and left unchanged ([`DehazeOptions::min_airlight_share`]).
+//!
 //! All intensities are divided by [`Observation::s0_scale`] first, so the transmission
 //! does not depend on the exposure and the radiance scales with it. Saturated and
 //! zero pixels ([`Observation::is_valid`]) take no part in any estimate; their
@@ -186,13 +189,25 @@ pub struct DehazeOptions {
     /// filter with `eps` = 9 noise variances, [`refine::denoise`]); 0 inverts S0 as measured.
     /// The inversion multiplies noise by `1 / t`; on a noiseless image this is the identity.
     pub denoise_radius: usize,
+    /// The polarization method (also after its dark-channel fallback) leaves the frame
+    /// unchanged (`t = 1`, a warning) where the airlight it finds makes up less than this
+    /// share of the light on average,
+    /// `mean(1 - t)` over the valid pixels: a haze-free frame's polarized objects (glossy
+    /// highlights, a weakly polarized floor) are otherwise read as a thin veil of haze and
+    /// "dehazed". 0 never leaves a frame unchanged. In `[0, 1]`.
+    pub min_airlight_share: f32,
 }
+
+/// The default [`DehazeOptions::min_airlight_share`]: between the haze-free frames' mean
+/// airlight share and the hazy frames' (docs/benchmarks.md, "dehaze: a frame without
+/// haze is left as it is").
+pub const MIN_AIRLIGHT_SHARE: f32 = 0.15;
 
 impl Default for DehazeOptions {
     /// Polarization, `t_min = 0.1`, guided filter of [`GuidedRadius::Adaptive`] radius and
     /// `eps = 1e-3`, dark channel patch 15 and `omega = 0.95` (He et al.),
     /// `min_airlight_dolp = 0.02`, dark-channel fallback, varying airlight, denoising
-    /// radius 2.
+    /// radius 2, [`MIN_AIRLIGHT_SHARE`].
     fn default() -> Self {
         Self {
             method: Method::Polarization,
@@ -205,6 +220,7 @@ impl Default for DehazeOptions {
             weak_fallback: WeakPolarization::DarkChannel,
             varying_airlight: true,
             denoise_radius: 2,
+            min_airlight_share: MIN_AIRLIGHT_SHARE,
         }
     }
 }
@@ -239,6 +255,13 @@ impl DehazeOptions {
             return bad(
                 "min_airlight_dolp",
                 self.min_airlight_dolp.into(),
+                "must be in [0, 1]",
+            );
+        }
+        if !(self.min_airlight_share >= 0.0 && self.min_airlight_share <= 1.0) {
+            return bad(
+                "min_airlight_share",
+                self.min_airlight_share.into(),
                 "must be in [0, 1]",
             );
         }
@@ -284,9 +307,31 @@ pub fn dehaze(obs: &Observation, opts: &DehazeOptions) -> Result<Dehazed, Dehaze
         Method::Polarization => polarization::transmission(&input, opts)?,
     };
     warnings.extend(estimate.warnings.iter().cloned());
-    let t = refine::refine(&input, &estimate.raw_t, opts, estimate.guided_eps)?;
+    let mut t = refine::refine(&input, &estimate.raw_t, opts, estimate.guided_eps)?;
+    if opts.method == Method::Polarization {
+        let share = airlight_share(&t, &input.valid);
+        if share < opts.min_airlight_share {
+            warnings.push(format!(
+                "no haze found: the airlight makes up {share:.3} of the light on average, \
+                 below min_airlight_share {}: image left unchanged (t = 1)",
+                opts.min_airlight_share
+            ));
+            t.as_mut_slice().fill(1.0);
+        }
+    }
     let s0 = refine::denoise(&input, &t, opts.denoise_radius)?;
     Ok(finish(&input, &s0, t, &estimate, opts.t_min, warnings))
+}
+
+/// The airlight's mean share of the light, `mean(1 - t)` over the valid pixels (0 without
+/// any).
+fn airlight_share(t: &Gray<f32>, valid: &[bool]) -> f32 {
+    let (sum, n) = (t.as_slice().iter().zip(valid))
+        .filter(|&(t, &ok)| ok && t.is_finite())
+        .fold((0.0f64, 0usize), |(s, n), (t, _)| {
+            (s + f64::from(1.0 - t.clamp(0.0, 1.0)), n + 1)
+        });
+    if n == 0 { 0.0 } else { (sum / n as f64) as f32 }
 }
 
 /// A raw (unrefined) transmission and the airlight it assumes, in normalised units.

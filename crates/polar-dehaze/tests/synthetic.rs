@@ -249,6 +249,82 @@ fn a_near_object_polarized_off_the_airlights_angle_is_not_haze() {
     assert!(t_object > 0.95, "mean t on the object {t_object}");
 }
 
+/// A haze-free frame (t = 1) with a glossy highlight: 20 x 28 pixels (6 % of the frame)
+/// polarized 0.3 along one angle, which the airlight's estimator takes for the sky (the
+/// most polarized region) and everything polarized like it for airlight. Read as haze,
+/// the highlight would be "dehazed" (`t` about 0.5 on it); its airlight makes up a few %
+/// of the frame's light on average, below `min_airlight_share`, so the frame is left as
+/// it is, with a warning.
+#[test]
+fn haze_free_frame_with_a_polarized_highlight_is_left_unchanged() {
+    let mut scene = Haze::standard(0, 0.0);
+    scene.t.iter_mut().for_each(|t| *t = 1.0);
+    let (s0, mut s1, mut s2) = scene.planes();
+    let highlight =
+        |k: usize| (40..60).contains(&(k / scene.w)) && (30..58).contains(&(k % scene.w));
+    for k in (0..s0.len()).filter(|&k| highlight(k)) {
+        let angle = 2.0 * scene.alpha[k];
+        s1[k] = 0.3 * s0[k] * angle.cos();
+        s2[k] = 0.3 * s0[k] * angle.sin();
+    }
+    let obs = observation(scene.w, scene.h, s0.clone(), s1, s2);
+    let ungated = DehazeOptions {
+        min_airlight_share: 0.0,
+        ..DehazeOptions::default()
+    };
+    let read_as_haze = dehaze(&obs, &ungated).unwrap();
+    assert_eq!(read_as_haze.method, Method::Polarization);
+    let t = read_as_haze.transmission.as_slice();
+    let t_highlight = mean_err(t, &vec![0.0; t.len()], highlight);
+    assert!(
+        t_highlight < 0.7,
+        "ungated: mean t on the highlight {t_highlight}"
+    );
+    let out = dehaze(&obs, &DehazeOptions::default()).unwrap();
+    assert!(out.transmission.as_slice().iter().all(|&t| t == 1.0));
+    assert!(out.depth.as_slice().iter().all(|&d| d == 0.0));
+    // (S0 - A) / 1 + A rounds twice in f32: a few ulp.
+    let e = max_err(out.radiance.as_slice(), &s0, |_| true) / scene.unit;
+    assert!(e < 1e-6, "largest change {e}");
+    assert!(
+        out.warnings.iter().any(|w| w.contains("no haze found")),
+        "{:?}",
+        out.warnings
+    );
+}
+
+#[test]
+fn a_hazy_frame_is_not_taken_for_a_haze_free_one() {
+    let scene = Haze::standard(16, 0.3);
+    let out = dehaze(&scene.observation(), &DehazeOptions::default()).unwrap();
+    assert!(!out.warnings.iter().any(|w| w.contains("no haze found")));
+    // Its true airlight share, mean(1 - t), is 0.54, far above the default bar.
+    let share = scene.t.iter().map(|t| 1.0 - t).sum::<f32>() / scene.t.len() as f32;
+    assert!(share > 3.0 * polar_dehaze::MIN_AIRLIGHT_SHARE, "{share}");
+}
+
+#[test]
+fn min_airlight_share_outside_zero_to_one_is_an_option_error() {
+    let scene = Haze::standard(16, 0.3);
+    for bad in [-0.1, 1.5, f32::NAN] {
+        let opts = DehazeOptions {
+            min_airlight_share: bad,
+            ..DehazeOptions::default()
+        };
+        let err = dehaze(&scene.observation(), &opts).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                polar_dehaze::DehazeError::Option {
+                    name: "min_airlight_share",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+    }
+}
+
 #[test]
 fn haze_free_input_gives_t_near_one_with_dark_channel_fallback() {
     // Haze-free with dark squares in every 15x15 patch: the dark channel is 0.03 / A with

@@ -55,6 +55,11 @@ pub struct TaskArgs {
     #[arg(verbatim_doc_comment)]
     #[arg(long, value_name = "NAME", default_value = "polarization", value_parser = parse_name::<DehazeMethod>)]
     pub dehaze_method: DehazeMethod,
+    /// Dehazing by polarization leaves a frame unchanged (with a warning) where the airlight
+    /// it finds makes up less than this share of the light on average: a haze-free frame's
+    /// glossy highlights would otherwise be read as thin haze. 0 dehazes every frame.
+    #[arg(long, value_name = "SHARE", default_value_t = polar_dehaze::MIN_AIRLIGHT_SHARE, value_parser = parse_share)]
+    pub dehaze_min_airlight: f32,
     /// Material classification by k nearest neighbours with this model file (made by
     /// `polar-vision train material`), or `builtin` for the model shipped with the program
     /// (trained on datasets-synth/suites/material-train.toml). Default: the physics rule,
@@ -191,6 +196,15 @@ fn parse_fov(s: &str) -> Result<f64, String> {
         Ok(v)
     } else {
         Err(format!("{v} is not a field of view in (0, 180) degrees"))
+    }
+}
+
+fn parse_share(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not a share in [0, 1]"))
     }
 }
 

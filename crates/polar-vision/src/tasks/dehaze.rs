@@ -16,6 +16,7 @@ use crate::writes::Writes;
 pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     let opts = DehazeOptions {
         method: args.dehaze_method,
+        min_airlight_share: args.dehaze_min_airlight,
         ..DehazeOptions::default()
     };
     let d = dehaze(ctx.obs, &opts).map_err(|e| Failure::CannotRun(e.to_string()))?;
