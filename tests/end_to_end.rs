@@ -506,6 +506,46 @@ fn run_outputs_are_identical_whatever_the_threads() {
     }
 }
 
+/// `run --tasks dehaze` on a haze-free ci sample leaves the frame as it is (`dehazed.exr`
+/// is the input's S0, with a "no haze found" message) and dehazes a hazy one. The ci
+/// frames' mean airlight shares: 0.010-0.067 on the twelve haze-free samples, 0.276 and
+/// 0.293 on the two hazy ones, against the bar of 0.15.
+#[test]
+fn run_leaves_a_haze_free_frame_unchanged_and_dehazes_a_hazy_one() {
+    for (name, hazy) in [("sfp-00001", false), ("haze-00000", true)] {
+        let out = tempfile::tempdir().unwrap();
+        let sample = standard_ci().join(name);
+        let ok = vision(&[
+            "run",
+            arg(&sample),
+            "--out",
+            arg(out.path()),
+            "--tasks",
+            "dehaze",
+        ]);
+        assert_eq!(ok, Ok(true), "{name}");
+        let messages =
+            json(&out.path().join(vision::METRICS))["tasks"]["dehaze"]["messages"].to_string();
+        assert_eq!(
+            !messages.contains("no haze found"),
+            hazy,
+            "{name}: {messages}"
+        );
+        let s0 = polar_io::read_exr_channel(out.path().join(vision::STOKES), "S0").unwrap();
+        let dehazed = polar_io::read_exr_channel(out.path().join(vision::DEHAZED), "Y").unwrap();
+        let top = s0.as_slice().iter().copied().fold(0.0f32, f32::max);
+        // Left as it is: (S0 - A) / 1 + A in f32, a few ulp of the brightest pixel.
+        let largest_change = (s0.as_slice().iter().zip(dehazed.as_slice()))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert_eq!(
+            largest_change > 1e-5 * top,
+            hazy,
+            "{name}: change {largest_change}"
+        );
+    }
+}
+
 /// A colour camera's sample: the ci shape sample's grey-world mosaic read as an IMX250MYR
 /// one (`sensor.pattern` of a meta.json with no other key; the polarizer angles sit where
 /// they do in the mono layout, so the same frame is a valid colour mosaic of a grey
