@@ -438,6 +438,8 @@ fn allowed_keys(kind: ShapeType) -> &'static [&'static str] {
     }
 }
 
+/// Shape `key` of a scene file: its keys checked against its type, its mesh placed, its
+/// material looked up by name.
 fn shape(
     s: &ShapeDesc,
     key: &str,
@@ -445,96 +447,21 @@ fn shape(
     file: &Path,
     base: &Path,
 ) -> Result<Shape, Error> {
-    let given = [
-        ("center", s.center.is_some()),
-        ("radius", s.radius.is_some()),
-        ("file", s.file.is_some()),
-        ("translate", s.translate.is_some()),
-        ("rotate_deg", s.rotate_deg.is_some()),
-        ("scale", s.scale.is_some()),
-        ("segments", s.segments.is_some()),
-        ("minor_radius", s.minor_radius.is_some()),
-        ("exponents", s.exponents.is_some()),
-    ];
-    let allowed = allowed_keys(s.kind);
-    if let Some((k, _)) = given.iter().find(|(k, set)| *set && !allowed.contains(k)) {
-        return Err(invalid(
-            file,
-            format!("{key}.{k}"),
-            format!("not used by shape type {:?}; allowed: {allowed:?}", s.kind),
-        ));
-    }
-    let require = |v: Option<f64>, k: &str| {
-        v.ok_or_else(|| {
-            invalid(
-                file,
-                format!("{key}.{k}"),
-                format!("required for shape type {:?}", s.kind),
-            )
-        })
-    };
-    let segments = s.segments.unwrap_or(64).max(3);
-    if segments > shapes::MAX_SEGMENTS {
-        return Err(invalid(
-            file,
-            format!("{key}.segments"),
-            format!("{segments} is more than {}", shapes::MAX_SEGMENTS),
-        ));
-    }
-    let scale = match s.scale {
-        None => [1.0; 3],
-        Some(Scale::Uniform(k)) => [k; 3],
-        Some(Scale::Axes(a)) => a,
-    };
+    check_shape_keys(s, key, file)?;
     let placement = shapes::transform(
         s.translate.unwrap_or_default(),
         s.rotate_deg.unwrap_or_default(),
-        scale,
+        match s.scale {
+            None => [1.0; 3],
+            Some(Scale::Uniform(k)) => [k; 3],
+            Some(Scale::Axes(a)) => a,
+        },
     );
-    let mesh = match s.kind {
-        ShapeType::Sphere => None,
-        ShapeType::TessellatedSphere => Some(shapes::uv_sphere(segments)),
-        ShapeType::Rectangle => Some(shapes::rectangle()),
-        ShapeType::Cube => Some(shapes::cube()),
-        ShapeType::Disk => Some(shapes::disk(segments)),
-        ShapeType::Torus => {
-            let minor = require(s.minor_radius, "minor_radius")?;
-            // At or above the major radius 1 the tube crosses the axis and the surface
-            // intersects itself.
-            if !(minor > 0.0 && minor < 1.0) {
-                return Err(invalid(
-                    file,
-                    format!("{key}.minor_radius"),
-                    format!("{minor} must be in (0, 1) (the major radius is 1)"),
-                ));
-            }
-            Some(shapes::torus(minor, segments))
-        }
-        ShapeType::Superquadric => {
-            let [e1, e2] = s.exponents.ok_or_else(|| {
-                invalid(
-                    file,
-                    format!("{key}.exponents"),
-                    "required for shape type Superquadric",
-                )
-            })?;
-            Some(shapes::superquadric(e1, e2, segments))
-        }
-        ShapeType::Mesh => {
-            let rel = s.file.as_ref().ok_or_else(|| {
-                invalid(file, format!("{key}.file"), "required for shape type Mesh")
-            })?;
-            let path = base.join(rel);
-            let mesh = shapes::load_mesh(&path)
-                .map_err(|e| invalid(file, format!("{key}.file"), e.to_string()))?;
-            Some(mesh)
-        }
-    };
-    let geometry = match mesh {
+    let geometry = match shape_mesh(s, key, file, base)? {
         Some(m) => Geometry::Mesh(m.transformed(&placement)),
         None => Geometry::Sphere {
             center: s.center.unwrap_or_default().into(),
-            radius: require(s.radius, "radius")?,
+            radius: s.radius.ok_or_else(|| required(s, key, "radius", file))?,
         },
     };
     let material = match &s.material {
@@ -547,11 +474,7 @@ fn shape(
             )
         })?),
     };
-    let emission = s.emission.map(|value| Emission {
-        value,
-        polarization: s.emission_polarization.unwrap_or_default(),
-    });
-    if s.emission_polarization.is_some() && emission.is_none() {
+    if s.emission_polarization.is_some() && s.emission.is_none() {
         return Err(invalid(
             file,
             format!("{key}.emission_polarization"),
@@ -561,7 +484,98 @@ fn shape(
     Ok(Shape {
         geometry,
         material,
-        emission,
+        emission: s.emission.map(|value| Emission {
+            value,
+            polarization: s.emission_polarization.unwrap_or_default(),
+        }),
         background: s.background,
+    })
+}
+
+/// An error unless every key given for shape `key` is one its type uses.
+fn check_shape_keys(s: &ShapeDesc, key: &str, file: &Path) -> Result<(), Error> {
+    let given = [
+        ("center", s.center.is_some()),
+        ("radius", s.radius.is_some()),
+        ("file", s.file.is_some()),
+        ("translate", s.translate.is_some()),
+        ("rotate_deg", s.rotate_deg.is_some()),
+        ("scale", s.scale.is_some()),
+        ("segments", s.segments.is_some()),
+        ("minor_radius", s.minor_radius.is_some()),
+        ("exponents", s.exponents.is_some()),
+    ];
+    let allowed = allowed_keys(s.kind);
+    match given.iter().find(|(k, set)| *set && !allowed.contains(k)) {
+        Some((k, _)) => Err(invalid(
+            file,
+            format!("{key}.{k}"),
+            format!("not used by shape type {:?}; allowed: {allowed:?}", s.kind),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The error for a key that shape `key`'s type requires and the file lacks.
+fn required(s: &ShapeDesc, key: &str, k: &str, file: &Path) -> Error {
+    invalid(
+        file,
+        format!("{key}.{k}"),
+        format!("required for shape type {:?}", s.kind),
+    )
+}
+
+/// The untransformed mesh of shape `key` (`None` for an analytic sphere); a mesh file is
+/// found relative to `base`.
+fn shape_mesh(
+    s: &ShapeDesc,
+    key: &str,
+    file: &Path,
+    base: &Path,
+) -> Result<Option<shapes::TriangleMesh>, Error> {
+    let segments = s.segments.unwrap_or(64).max(3);
+    if segments > shapes::MAX_SEGMENTS {
+        return Err(invalid(
+            file,
+            format!("{key}.segments"),
+            format!("{segments} is more than {}", shapes::MAX_SEGMENTS),
+        ));
+    }
+    Ok(match s.kind {
+        ShapeType::Sphere => None,
+        ShapeType::TessellatedSphere => Some(shapes::uv_sphere(segments)),
+        ShapeType::Rectangle => Some(shapes::rectangle()),
+        ShapeType::Cube => Some(shapes::cube()),
+        ShapeType::Disk => Some(shapes::disk(segments)),
+        ShapeType::Torus => {
+            let minor = s
+                .minor_radius
+                .ok_or_else(|| required(s, key, "minor_radius", file))?;
+            // At or above the major radius 1 the tube crosses the axis and the surface
+            // intersects itself.
+            if !(minor > 0.0 && minor < 1.0) {
+                return Err(invalid(
+                    file,
+                    format!("{key}.minor_radius"),
+                    format!("{minor} must be in (0, 1) (the major radius is 1)"),
+                ));
+            }
+            Some(shapes::torus(minor, segments))
+        }
+        ShapeType::Superquadric => {
+            let [e1, e2] = s
+                .exponents
+                .ok_or_else(|| required(s, key, "exponents", file))?;
+            Some(shapes::superquadric(e1, e2, segments))
+        }
+        ShapeType::Mesh => {
+            let rel = s
+                .file
+                .as_ref()
+                .ok_or_else(|| required(s, key, "file", file))?;
+            let mesh = shapes::load_mesh(&base.join(rel))
+                .map_err(|e| invalid(file, format!("{key}.file"), e.to_string()))?;
+            Some(mesh)
+        }
     })
 }
