@@ -197,6 +197,36 @@ impl Scene {
     }
 }
 
+/// The camera's values, as `(key, reason)` on failure.
+fn validate_camera(c: &Camera) -> Result<(), (String, String)> {
+    for (k, v) in [
+        ("camera.position", &c.position),
+        ("camera.look_at", &c.look_at),
+        ("camera.up", &c.up),
+    ] {
+        if !finite(v) {
+            return Err((k.into(), format!("not finite: {:?}", v.as_slice())));
+        }
+    }
+    if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
+        return Err((
+            "camera.fov_deg".into(),
+            format!("must be in (0, 180), got {}", c.fov_deg),
+        ));
+    }
+    if let Err((k, r)) = check_image_size(c.width, c.height) {
+        return Err((format!("camera.{k}"), r));
+    }
+    let view = c.look_at - c.position;
+    if view.norm() == 0.0 || view.cross(&c.up).norm() <= 1e-9 * view.norm() * c.up.norm() {
+        return Err((
+            "camera.up".into(),
+            "look_at equals position, or up is parallel to the view direction".into(),
+        ));
+    }
+    Ok(())
+}
+
 /// Where a scene came from, for error messages of scenes built in code.
 const BUILT_IN_CODE: &str = "<scene built in code>";
 
@@ -209,70 +239,60 @@ impl Scene {
 
     /// [`Self::validate`], naming `file` in errors.
     pub(crate) fn validate_as(&self, file: &Path) -> Result<(), Error> {
-        let bad = |key: String, reason: String| {
-            Err(Error::Invalid {
-                file: file.to_owned(),
-                key,
-                reason,
-            })
+        let bad = |(key, reason): (String, String)| Error::Invalid {
+            file: file.to_owned(),
+            key,
+            reason,
         };
-        let c = &self.camera;
-        for (k, v) in [
-            ("camera.position", &c.position),
-            ("camera.look_at", &c.look_at),
-            ("camera.up", &c.up),
-        ] {
-            if !finite(v) {
-                return bad(k.into(), format!("not finite: {:?}", v.as_slice()));
+        validate_camera(&self.camera).map_err(bad)?;
+        self.validate_settings().map_err(bad)?;
+        for NamedMaterial { name, material } in &self.materials {
+            if let Err(polar_bsdf::Error::InvalidParameter { field, reason }) = material.validate()
+            {
+                return Err(bad((format!("materials.{name}.{field}"), reason)));
             }
         }
-        if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
-            return bad(
-                "camera.fov_deg".into(),
-                format!("must be in (0, 180), got {}", c.fov_deg),
-            );
+        for (i, s) in self.shapes.iter().enumerate() {
+            self.validate_shape(s)
+                .map_err(|(k, r)| bad((format!("shapes[{i}].{k}"), r)))?;
         }
-        if let Err((k, r)) = check_image_size(c.width, c.height) {
-            return bad(format!("camera.{k}"), r);
+        self.validate_lights().map_err(bad)?;
+        if let Some(m) = &self.medium {
+            m.validate()
+                .map_err(|(k, r)| bad((format!("medium.{k}"), r)))?;
         }
-        let view = c.look_at - c.position;
-        if view.norm() == 0.0 || view.cross(&c.up).norm() <= 1e-9 * view.norm() * c.up.norm() {
-            return bad(
-                "camera.up".into(),
-                "look_at equals position, or up is parallel to the view direction".into(),
-            );
-        }
+        Ok(())
+    }
+
+    /// The render settings' ranges, as `(key, reason)` on failure.
+    fn validate_settings(&self) -> Result<(), (String, String)> {
         for (k, v, max) in [
             ("render.spp", self.settings.spp, MAX_SPP),
             ("render.max_depth", self.settings.max_depth, MAX_PATH_DEPTH),
         ] {
             if !(1..=max).contains(&v) {
-                return bad(k.into(), format!("{v} must be in 1..={max}"));
+                return Err((k.into(), format!("{v} must be in 1..={max}")));
             }
         }
         if self.settings.split_depth > MAX_SPLIT_DEPTH {
-            return bad(
+            return Err((
                 "render.split_depth".into(),
                 format!("must be at most {MAX_SPLIT_DEPTH} (where Russian roulette starts)"),
-            );
+            ));
         }
-        for NamedMaterial { name, material } in &self.materials {
-            if let Err(polar_bsdf::Error::InvalidParameter { field, reason }) = material.validate()
-            {
-                return bad(format!("materials.{name}.{field}"), reason);
-            }
-        }
-        for (i, s) in self.shapes.iter().enumerate() {
-            self.validate_shape(s)
-                .or_else(|(k, r)| bad(format!("shapes[{i}].{k}"), r))?;
-        }
+        Ok(())
+    }
+
+    /// Each light's values and at most one environment or sky, as `(key, reason)` on
+    /// failure.
+    fn validate_lights(&self) -> Result<(), (String, String)> {
         let mut environments = 0;
         for (i, l) in self.lights.iter().enumerate() {
             let (e, key) = match l {
                 Light::Sky(sky) => {
                     environments += 1;
                     sky.validate()
-                        .or_else(|e| bad(format!("lights[{i}].{}", sky_key(&e)), e.to_string()))?;
+                        .map_err(|e| (format!("lights[{i}].{}", sky_key(&e)), e.to_string()))?;
                     continue;
                 }
                 Light::Environment(e) => {
@@ -284,36 +304,27 @@ impl Scene {
                     emission,
                 } => {
                     if !finite(direction) || direction.norm() == 0.0 {
-                        return bad(
+                        return Err((
                             format!("lights[{i}].direction"),
                             format!(
                                 "must be finite and non-zero, got {:?}",
                                 direction.as_slice()
                             ),
-                        );
+                        ));
                     }
                     (emission, "irradiance")
                 }
             };
-            check_emission(e).or_else(|(k, r)| {
-                bad(
-                    format!(
-                        "lights[{i}].{}",
-                        if k == "value" { key } else { "polarization" }
-                    ),
-                    r,
-                )
+            check_emission(e).map_err(|(k, r)| {
+                let k = if k == "value" { key } else { "polarization" };
+                (format!("lights[{i}].{k}"), r)
             })?;
         }
         if environments > 1 {
-            return bad(
+            return Err((
                 "lights".into(),
                 format!("{environments} environment or sky lights; at most one is allowed"),
-            );
-        }
-        if let Some(m) = &self.medium {
-            m.validate()
-                .or_else(|(k, r)| bad(format!("medium.{k}"), r))?;
+            ));
         }
         Ok(())
     }
