@@ -114,8 +114,24 @@ struct Acc {
     covered: Vec<f64>,
 }
 
+/// Per (method, noise level): the accumulated scores.
+type Scores = std::collections::BTreeMap<(String, String), Acc>;
+
 fn main() {
     let a = args();
+    let dirs = sample_dirs(&a);
+    if let Some(first) = dirs.first().filter(|_| a.speed) {
+        speed(first);
+    }
+    let mut acc = Scores::new();
+    for dir in &dirs {
+        println!("{}", evaluate_sample(dir, &a, &mut acc));
+    }
+    print_summary(&acc);
+}
+
+/// The shape samples under `a.root` (ours `sfp-*`, Mitsuba's `mts-shape-*`), sorted.
+fn sample_dirs(a: &Args) -> Vec<PathBuf> {
     let mut dirs: Vec<PathBuf> = std::fs::read_dir(&a.root)
         .unwrap()
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -127,117 +143,147 @@ fn main() {
         })
         .collect();
     dirs.sort();
-    if let Some(first) = dirs.first().filter(|_| a.speed) {
-        speed(first);
+    dirs
+}
+
+/// Runs both methods (and the oracle foregrounds where asked) on one sample, adds their
+/// scores to `acc` and returns the sample's line.
+fn evaluate_sample(dir: &Path, a: &Args, acc: &mut Scores) -> String {
+    let s = polar_io::read_sample(dir).unwrap();
+    // polar-datagen: sensor.noise.name; the Mitsuba task scenes: sensor.noise.
+    let noise_key = &s.meta["sensor"]["noise"];
+    let noise = noise_key["name"]
+        .as_str()
+        .or(noise_key.as_str())
+        .unwrap_or("?")
+        .to_string();
+    let fov = s.meta["camera"]["fov_deg"].as_f64().expect("fov_deg");
+    let obs = observation(dir, fov, a.exr);
+    let gt = s.gt.normal.as_ref().expect("gt normal");
+    let label = s.gt.material.as_ref().expect("gt material");
+    let mask = Gray::from_vec(
+        label.width(),
+        label.height(),
+        label.as_slice().iter().map(|&l| u8::from(l != 0)).collect(),
+    )
+    .unwrap();
+    let name = dir.file_name().unwrap().to_string_lossy().to_string();
+    let true_iors: Vec<String> = s.meta["scene"]["objects"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|o| o["material"]["ior"].as_f64())
+        .map(|n| format!("{n:.3}"))
+        .collect();
+    let mut line = format!("{name} {noise:9} true n [{}]", true_iors.join(" "));
+    let truth = Truth {
+        gt,
+        mask: &mask,
+        fov,
+    };
+    for m in [Method::Local, Method::Global] {
+        let e = acc.entry((m.to_string(), noise.clone())).or_default();
+        line += &score_method(&obs, m, a, &truth, e, &name);
     }
-    let methods = [Method::Local, Method::Global];
-    let mut acc: std::collections::BTreeMap<(String, String), Acc> = Default::default();
-    for dir in &dirs {
-        let s = polar_io::read_sample(dir).unwrap();
-        // polar-datagen: sensor.noise.name; the Mitsuba task scenes: sensor.noise.
-        let noise_key = &s.meta["sensor"]["noise"];
-        let noise = noise_key["name"]
-            .as_str()
-            .or(noise_key.as_str())
-            .unwrap_or("?")
-            .to_string();
-        let fov = s.meta["camera"]["fov_deg"].as_f64().expect("fov_deg");
-        let obs = observation(dir, fov, a.exr);
-        let gt = s.gt.normal.as_ref().expect("gt normal");
-        let label = s.gt.material.as_ref().expect("gt material");
-        let mask = Gray::from_vec(
-            label.width(),
-            label.height(),
-            label.as_slice().iter().map(|&l| u8::from(l != 0)).collect(),
-        )
-        .unwrap();
-        let name = dir.file_name().unwrap().to_string_lossy().to_string();
-        let true_iors: Vec<String> = s.meta["scene"]["objects"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(|o| o["material"]["ior"].as_f64())
-            .map(|n| format!("{n:.3}"))
-            .collect();
-        let mut line = format!("{name} {noise:9} true n [{}]", true_iors.join(" "));
-        for m in methods {
-            let opts = ShapeOptions {
-                method: m,
-                integrator: Integrator::Poisson,
-                ior: a.ior,
-                working_size: a.working_size,
-            };
-            let t = Instant::now();
-            let shape = estimate_shape(&obs, &opts).unwrap();
-            let secs = t.elapsed().as_secs_f64();
-            let st = angular_error(&shape.normal, gt, Some(&mask)).unwrap();
-            let e = acc.entry((m.to_string(), noise.clone())).or_default();
-            let missing = count_missing(&shape.normal, &mask);
-            let iou = polar_imgproc::iou(&shape.foreground, &mask)
-                .unwrap()
-                .unwrap_or(0.0);
-            e.ious.push(iou);
-            if m == Method::Local {
-                let light = shape.light.map_or("none".into(), |l| {
-                    let d = l.direction().unwrap_or_default();
-                    format!(
-                        "({:.2} {:.2} {:.2}) x{:.2} + {:.2}",
-                        d.x,
-                        d.y,
-                        d.z,
-                        l.strength(),
-                        l.ambient
-                    )
-                });
-                line += &format!(" | n {:.3} {} | light {light}", shape.ior, shape.ior_source);
-            }
-            e.secs += secs;
-            if let Some(st) = st {
-                e.means.push(st.mean);
-                e.medians.push(st.median);
-                e.pooled.push((st.mean, st.count));
-                line += &format!(
-                    " | {m}: mean {:5.1} med {:5.1} <11.25 {:4.0}% miss {missing:4} iou {iou:.2} ({:.0} ms)",
-                    st.mean,
-                    st.median,
-                    st.pct_below_11_25,
-                    secs * 1e3
-                );
-            }
-            let full = angular_error(&facing_where_missing(&shape.normal), gt, Some(&mask))
-                .unwrap()
-                .map_or(f64::NAN, |s| s.mean);
-            e.covered.push(full);
-            line += &format!(" full {full:5.1}");
-            let (ez, ea) = split_error(&shape.normal, gt, &mask, fov);
-            line += &format!(" zen {ez:4.1} az {ea:4.1}");
-            if let Some(d) = &a.debug {
-                debug_pictures(d, &name, &m.to_string(), &shape, gt, &mask);
-            }
-        }
-        if a.oracle_fg {
-            for prior_only in [false, true] {
-                let (mean, median, normals) = oracle_foreground(&obs, gt, &mask, prior_only);
-                let (ez, ea) = split_error(&normals, gt, &mask, fov);
-                line += &format!(
-                    " | gt mask (prior only {prior_only}): mean {mean:5.1} med {median:5.1} zen {ez:4.1} az {ea:4.1}"
-                );
-                let e = acc
-                    .entry((format!("oracle{}", u8::from(prior_only)), noise.clone()))
-                    .or_default();
-                e.means.push(mean);
-                e.medians.push(median);
-            }
-        }
-        println!("{line}");
-        if let Some(d) = &a.debug {
-            cue_pictures(d, &name, &obs);
+    if a.oracle_fg {
+        for prior_only in [false, true] {
+            let (mean, median, normals) = oracle_foreground(&obs, gt, &mask, prior_only);
+            let (ez, ea) = split_error(&normals, gt, &mask, fov);
+            line += &format!(
+                " | gt mask (prior only {prior_only}): mean {mean:5.1} med {median:5.1} zen {ez:4.1} az {ea:4.1}"
+            );
+            let e = acc
+                .entry((format!("oracle{}", u8::from(prior_only)), noise.clone()))
+                .or_default();
+            e.means.push(mean);
+            e.medians.push(median);
         }
     }
+    if let Some(d) = &a.debug {
+        cue_pictures(d, &name, &obs);
+    }
+    line
+}
+
+/// A sample's true normals, object mask and field of view.
+struct Truth<'a> {
+    gt: &'a NormalImage,
+    mask: &'a Gray<u8>,
+    fov: f64,
+}
+
+/// Runs method `m` on `obs`, adds its scores to `e` and returns its part of the line.
+fn score_method(
+    obs: &Observation,
+    m: Method,
+    a: &Args,
+    truth: &Truth,
+    e: &mut Acc,
+    name: &str,
+) -> String {
+    let (gt, mask) = (truth.gt, truth.mask);
+    let opts = ShapeOptions {
+        method: m,
+        integrator: Integrator::Poisson,
+        ior: a.ior,
+        working_size: a.working_size,
+    };
+    let t = Instant::now();
+    let shape = estimate_shape(obs, &opts).unwrap();
+    let secs = t.elapsed().as_secs_f64();
+    let st = angular_error(&shape.normal, gt, Some(mask)).unwrap();
+    let missing = count_missing(&shape.normal, mask);
+    let iou = polar_imgproc::iou(&shape.foreground, mask)
+        .unwrap()
+        .unwrap_or(0.0);
+    e.ious.push(iou);
+    let mut line = String::new();
+    if m == Method::Local {
+        let light = shape.light.map_or("none".into(), |l| {
+            let d = l.direction().unwrap_or_default();
+            format!(
+                "({:.2} {:.2} {:.2}) x{:.2} + {:.2}",
+                d.x,
+                d.y,
+                d.z,
+                l.strength(),
+                l.ambient
+            )
+        });
+        line += &format!(" | n {:.3} {} | light {light}", shape.ior, shape.ior_source);
+    }
+    e.secs += secs;
+    if let Some(st) = st {
+        e.means.push(st.mean);
+        e.medians.push(st.median);
+        e.pooled.push((st.mean, st.count));
+        line += &format!(
+            " | {m}: mean {:5.1} med {:5.1} <11.25 {:4.0}% miss {missing:4} iou {iou:.2} ({:.0} ms)",
+            st.mean,
+            st.median,
+            st.pct_below_11_25,
+            secs * 1e3
+        );
+    }
+    let full = angular_error(&facing_where_missing(&shape.normal), gt, Some(mask))
+        .unwrap()
+        .map_or(f64::NAN, |s| s.mean);
+    e.covered.push(full);
+    line += &format!(" full {full:5.1}");
+    let (ez, ea) = split_error(&shape.normal, gt, mask, truth.fov);
+    line += &format!(" zen {ez:4.1} az {ea:4.1}");
+    if let Some(d) = &a.debug {
+        debug_pictures(d, name, &m.to_string(), &shape, gt, mask);
+    }
+    line
+}
+
+/// One line per method and noise level: means, medians, pooled mean, IoU, time.
+fn print_summary(acc: &Scores) {
     println!(
         "\nsummary (per-sample mean of mean / median of per-sample medians, pooled pixel mean):"
     );
-    for ((m, noise), e) in &acc {
+    for ((m, noise), e) in acc {
         let n = e.means.len().max(1) as f64;
         let mut med = e.medians.clone();
         med.sort_by(f64::total_cmp);
