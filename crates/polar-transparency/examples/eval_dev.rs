@@ -110,10 +110,22 @@ struct Opaque {
     fp: u64,
 }
 
-fn main() {
+/// The command line.
+struct Options {
+    root: PathBuf,
+    from_stokes: bool,
+    verbose: bool,
+    /// `DUMP`: a picture per sample there.
+    dump: Option<String>,
+    segmenter: Segmenter,
+    thresholds: Vec<Option<f32>>,
+    /// Name prefix of the glass samples.
+    prefix: String,
+}
+
+fn options() -> Options {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let from_stokes = args.iter().any(|a| a == "--stokes");
-    let verbose = args.iter().any(|a| a == "-v");
     let root = args
         .iter()
         .enumerate()
@@ -123,7 +135,6 @@ fn main() {
         })
         .map(|(_, a)| a)
         .map_or_else(|| PathBuf::from("/work/data/dev"), PathBuf::from);
-    let dump = std::env::var("DUMP").ok();
     let value = |name: &str| {
         args.iter()
             .position(|a| a == name)
@@ -138,25 +149,36 @@ fn main() {
             KnnClassifier::load(Path::new(&m), EXPECT).unwrap(),
         )),
     };
-    let thresholds: Vec<Option<f32>> = match value("--thresholds") {
+    let thresholds = match value("--thresholds") {
         None => vec![None],
         Some(t) => t.split(',').map(|v| Some(v.parse().unwrap())).collect(),
     };
-    let prefix = value("--glass").unwrap_or_else(|| "glass-".into());
-    let glass: Vec<Case> = dirs(&root, &prefix)
-        .iter()
-        .map(|d| load(d, from_stokes))
-        .collect();
-    let opaque: Vec<Case> = dirs(&root, "materials-")
-        .iter()
-        .map(|d| load(d, from_stokes))
-        .collect();
+    Options {
+        root,
+        from_stokes,
+        verbose: args.iter().any(|a| a == "-v"),
+        dump: std::env::var("DUMP").ok(),
+        segmenter,
+        thresholds,
+        prefix: value("--glass").unwrap_or_else(|| "glass-".into()),
+    }
+}
+
+fn main() {
+    let o = options();
+    let load_all = |prefix: &str| -> Vec<Case> {
+        dirs(&o.root, prefix)
+            .iter()
+            .map(|d| load(d, o.from_stokes))
+            .collect()
+    };
+    let (glass, opaque) = (load_all(&o.prefix), load_all("materials-"));
     println!(
         "{} glass and {} materials samples from {} ({})",
         glass.len(),
         opaque.len(),
-        root.display(),
-        if from_stokes {
+        o.root.display(),
+        if o.from_stokes {
             polar_io::files::STOKES
         } else {
             polar_io::files::RAW
@@ -171,74 +193,95 @@ fn main() {
     noises.dedup();
     for (noise, threshold) in noises
         .iter()
-        .flat_map(|n| thresholds.iter().map(move |t| (n, *t)))
+        .flat_map(|n| o.thresholds.iter().map(move |t| (n, *t)))
     {
         let opts = TransparencyOptions { threshold };
-        let mut g = Glass::default();
-        for c in glass.iter().filter(|c| &c.noise == noise) {
-            let truth = binary(
-                c.transparent
-                    .as_ref()
-                    .expect(polar_io::files::GT_TRANSPARENT),
-            );
-            let t = Instant::now();
-            let out = detect(&c.obs, &segmenter, &opts).expect("detect");
-            g.secs += t.elapsed().as_secs_f64();
-            let pred = binary(&out.mask);
-            let one = iou(&pred, &truth).unwrap().unwrap_or(1.0);
-            g.iou_sum += one;
-            g.n += 1;
-            let (mut tp, mut fp, mut fneg) = (0, 0, 0);
-            for (&p, &t) in pred.as_slice().iter().zip(truth.as_slice()) {
-                tp += u64::from(p == 1 && t == 1);
-                fp += u64::from(p == 1 && t == 0);
-                fneg += u64::from(p == 0 && t == 1);
-            }
-            g.tp += tp;
-            g.fp += fp;
-            g.fneg += fneg;
-            if verbose {
-                println!("  {} IoU {:.3} tp {tp} fp {fp} fn {fneg}", c.name, one);
-            }
-            if let Some(d) = &dump {
-                picture(Path::new(d), c, &out.score, &out.mask, &truth);
-            }
-        }
-        let mut o = Opaque::default();
-        for c in opaque.iter().filter(|c| &c.noise == noise) {
-            let mat = c.material.as_ref().expect(polar_io::files::GT_MATERIAL);
-            let out = detect(&c.obs, &segmenter, &opts).expect("detect");
-            o.n += 1;
-            for (&p, &l) in out.mask.as_slice().iter().zip(mat.as_slice()) {
-                let obj = l == 1 || l == 2;
-                o.object += u64::from(obj);
-                o.object_fp += u64::from(obj && p != 0);
-                o.pixels += 1;
-                o.fp += u64::from(p != 0);
-            }
-            if let Some(d) = &dump {
-                picture(Path::new(d), c, &out.score, &out.mask, &binary(mat));
-            }
-        }
-        let pct = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
+        let g = score_glass(&of_noise(&glass, noise), &o, &opts);
+        let op = score_opaque(&of_noise(&opaque, noise), &o, &opts);
         println!("noise = {noise}, threshold {threshold:?}");
-        println!(
-            "  glass     n={:2} mean IoU {:.3}  pooled IoU {:.3}  precision {:5.1}%  recall {:5.1}%  {:.1} ms/img",
-            g.n,
-            g.iou_sum / g.n.max(1) as f64,
-            g.tp as f64 / (g.tp + g.fp + g.fneg).max(1) as f64,
-            pct(g.tp, g.tp + g.fp),
-            pct(g.tp, g.tp + g.fneg),
-            1e3 * g.secs / g.n.max(1) as f64
-        );
-        println!(
-            "  materials n={:2} false positives: {:5.2}% of opaque object pixels (labels 1, 2), {:5.2}% of all pixels",
-            o.n,
-            pct(o.object_fp, o.object),
-            pct(o.fp, o.pixels)
-        );
+        print_scores(&g, &op);
     }
-    time_megapixel(&segmenter);
+    time_megapixel(&o.segmenter);
+}
+
+/// The cases of noise level `noise`.
+fn of_noise<'a>(cases: &'a [Case], noise: &str) -> Vec<&'a Case> {
+    cases.iter().filter(|c| c.noise == noise).collect()
+}
+
+/// IoU, pixel counts and time over the glass samples.
+fn score_glass(cases: &[&Case], o: &Options, opts: &TransparencyOptions) -> Glass {
+    let mut g = Glass::default();
+    for c in cases {
+        let truth = binary(
+            c.transparent
+                .as_ref()
+                .expect(polar_io::files::GT_TRANSPARENT),
+        );
+        let t = Instant::now();
+        let out = detect(&c.obs, &o.segmenter, opts).expect("detect");
+        g.secs += t.elapsed().as_secs_f64();
+        let pred = binary(&out.mask);
+        let one = iou(&pred, &truth).unwrap().unwrap_or(1.0);
+        g.iou_sum += one;
+        g.n += 1;
+        let (mut tp, mut fp, mut fneg) = (0, 0, 0);
+        for (&p, &t) in pred.as_slice().iter().zip(truth.as_slice()) {
+            tp += u64::from(p == 1 && t == 1);
+            fp += u64::from(p == 1 && t == 0);
+            fneg += u64::from(p == 0 && t == 1);
+        }
+        g.tp += tp;
+        g.fp += fp;
+        g.fneg += fneg;
+        if o.verbose {
+            println!("  {} IoU {:.3} tp {tp} fp {fp} fn {fneg}", c.name, one);
+        }
+        if let Some(d) = &o.dump {
+            picture(Path::new(d), c, &out.score, &out.mask, &truth);
+        }
+    }
+    g
+}
+
+/// False positives over the opaque (materials) samples.
+fn score_opaque(cases: &[&Case], o: &Options, opts: &TransparencyOptions) -> Opaque {
+    let mut op = Opaque::default();
+    for c in cases {
+        let mat = c.material.as_ref().expect(polar_io::files::GT_MATERIAL);
+        let out = detect(&c.obs, &o.segmenter, opts).expect("detect");
+        op.n += 1;
+        for (&p, &l) in out.mask.as_slice().iter().zip(mat.as_slice()) {
+            let obj = l == 1 || l == 2;
+            op.object += u64::from(obj);
+            op.object_fp += u64::from(obj && p != 0);
+            op.pixels += 1;
+            op.fp += u64::from(p != 0);
+        }
+        if let Some(d) = &o.dump {
+            picture(Path::new(d), c, &out.score, &out.mask, &binary(mat));
+        }
+    }
+    op
+}
+
+fn print_scores(g: &Glass, o: &Opaque) {
+    let pct = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
+    println!(
+        "  glass     n={:2} mean IoU {:.3}  pooled IoU {:.3}  precision {:5.1}%  recall {:5.1}%  {:.1} ms/img",
+        g.n,
+        g.iou_sum / g.n.max(1) as f64,
+        g.tp as f64 / (g.tp + g.fp + g.fneg).max(1) as f64,
+        pct(g.tp, g.tp + g.fp),
+        pct(g.tp, g.tp + g.fneg),
+        1e3 * g.secs / g.n.max(1) as f64
+    );
+    println!(
+        "  materials n={:2} false positives: {:5.2}% of opaque object pixels (labels 1, 2), {:5.2}% of all pixels",
+        o.n,
+        pct(o.object_fp, o.object),
+        pct(o.fp, o.pixels)
+    );
 }
 
 /// Time of one 1024x1024 detection on a synthetic scene (a polarized disc per 256² tile).
