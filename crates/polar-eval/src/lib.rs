@@ -13,7 +13,8 @@ pub use aggregate::{Aggregate, Summary, aggregate, family_of};
 pub use depth::{DepthFit, depth_fit};
 pub use tasks::{
     DehazeMetrics, ImageScore, MaskMetrics, MaterialMetrics, NormalMetrics, REACHABLE_TRANSMISSION,
-    ReachableScore, dehaze_metrics, mask_metrics, material_metrics, normal_metrics, pearson,
+    ReachableScore, dehaze_metrics, gain_to, mask_metrics, material_metrics, normal_metrics,
+    pearson,
 };
 
 use thiserror::Error;

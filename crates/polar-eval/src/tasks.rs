@@ -385,6 +385,22 @@ fn transmission_error(est: &[f32], gt: &[f32]) -> (f64, Option<f64>) {
     (mae, pearson(est, gt))
 }
 
+/// The gain `k` minimising `Σ (k x − y)²` over the indices where `keep` holds and `y` is
+/// finite: the factor from an observation's unit to the truth's (a camera frame in DN, the
+/// truth in radiance) without the sensor's parameters. `None` where no pair counts or `x`
+/// is 0 on all of them.
+pub fn gain_to(x: &[f32], y: &[f32], keep: impl Fn(usize) -> bool) -> Option<f64> {
+    let (xy, xx) = (x.iter().zip(y).enumerate())
+        .filter(|&(k, (_, y))| keep(k) && y.is_finite())
+        .fold((0.0, 0.0), |(xy, xx), (_, (&x, &y))| {
+            (
+                xy + f64::from(x) * f64::from(y),
+                xx + f64::from(x) * f64::from(x),
+            )
+        });
+    (xx > 0.0).then(|| xy / xx)
+}
+
 /// Pearson correlation of two equally long series over the pairs where both are finite;
 /// `None` with fewer than 2 such pairs or a constant series.
 pub fn pearson(a: &[f32], b: &[f32]) -> Option<f64> {
@@ -412,6 +428,17 @@ pub fn pearson(a: &[f32], b: &[f32]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn gain_to_fits_the_scale_over_the_kept_finite_pixels() {
+        let x = [1.0f32, 2.0, 3.0, 4.0, 5.0];
+        // y = 2.5 x but for a NaN, a pixel left out (index 1) and a zero x.
+        let y = [2.5f32, 99.0, f32::NAN, 10.0, 12.5];
+        let k = gain_to(&x, &y, |i| i != 1).unwrap();
+        assert!((k - 2.5).abs() < 1e-12, "{k}");
+        assert_eq!(gain_to(&[0.0, 0.0], &[1.0, 2.0], |_| true), None);
+        assert_eq!(gain_to(&x, &y, |_| false), None);
+    }
 
     fn gray<T>(w: usize, v: Vec<T>) -> Gray<T> {
         let h = v.len() / w;

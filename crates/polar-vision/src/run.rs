@@ -194,21 +194,10 @@ fn radiance_per_unit(
         (InputFile::Stokes(_), _) => Ok(Some(1.0)),
         (InputFile::Raw(_), Some(path)) if gt.clear.is_some() || gt.dehazed.is_some() => {
             let truth = polar_io::read_exr_channel(&path, "S0")?;
-            let (mut xy, mut xx) = (0.0, 0.0);
-            for (k, (&x, &y)) in obs
-                .planes
-                .s0
-                .as_slice()
-                .iter()
-                .zip(truth.as_slice())
-                .enumerate()
-            {
-                if obs.is_valid(k) && y.is_finite() {
-                    xy += f64::from(x) * f64::from(y);
-                    xx += f64::from(x) * f64::from(x);
-                }
-            }
-            Ok((xx > 0.0).then(|| xy / xx))
+            let s0 = obs.planes.s0.as_slice();
+            Ok(polar_eval::gain_to(s0, truth.as_slice(), |k| {
+                obs.is_valid(k)
+            }))
         }
         _ => Ok(None),
     }
