@@ -191,10 +191,10 @@ pub struct DehazeOptions {
     pub denoise_radius: usize,
     /// The polarization method (also after its dark-channel fallback) leaves the frame
     /// unchanged (`t = 1`, a warning) where the airlight it finds makes up less than this
-    /// share of the light on average,
-    /// `mean(1 - t)` over the valid pixels: a haze-free frame's polarized objects (glossy
-    /// highlights, a weakly polarized floor) are otherwise read as a thin veil of haze and
-    /// "dehazed". 0 never leaves a frame unchanged. In `[0, 1]`.
+    /// share of the light on average, `mean(1 - t)` over the valid pixels: a haze-free
+    /// frame's polarized objects (glossy highlights, a weakly polarized floor) are
+    /// otherwise read as a thin veil of haze and "dehazed". 0 never leaves a frame
+    /// unchanged. In `[0, 1]`.
     pub min_airlight_share: f32,
 }
 
