@@ -308,16 +308,18 @@ pub fn dehaze(obs: &Observation, opts: &DehazeOptions) -> Result<Dehazed, Dehaze
     };
     warnings.extend(estimate.warnings.iter().cloned());
     let mut t = refine::refine(&input, &estimate.raw_t, opts, estimate.guided_eps)?;
-    if opts.method == Method::Polarization {
-        let share = airlight_share(&t, &input.valid);
-        if share < opts.min_airlight_share {
-            warnings.push(format!(
-                "no haze found: the airlight makes up {share:.3} of the light on average, \
-                 below min_airlight_share {}: image left unchanged (t = 1)",
-                opts.min_airlight_share
-            ));
-            t.as_mut_slice().fill(1.0);
-        }
+    let share = airlight_share(&t, &input.valid);
+    if opts.method == Method::Polarization && share < opts.min_airlight_share {
+        warnings.push(format!(
+            "no haze found: the airlight makes up {share:.3} of the light on average, \
+             below min_airlight_share {}: image left unchanged (t = 1)",
+            opts.min_airlight_share
+        ));
+        t.as_mut_slice().fill(1.0);
+        // Denoising is blended in by 1 - t: nothing to do.
+        return Ok(finish(
+            &input, &input.s0, t, &estimate, opts.t_min, warnings,
+        ));
     }
     let s0 = refine::denoise(&input, &t, opts.denoise_radius)?;
     Ok(finish(&input, &s0, t, &estimate, opts.t_min, warnings))

@@ -249,12 +249,11 @@ fn a_near_object_polarized_off_the_airlights_angle_is_not_haze() {
     assert!(t_object > 0.95, "mean t on the object {t_object}");
 }
 
-/// A haze-free frame (t = 1) with a glossy highlight: 20 x 28 pixels (6 % of the frame)
-/// polarized 0.3 along one angle, which the airlight's estimator takes for the sky (the
-/// most polarized region) and everything polarized like it for airlight. Read as haze,
-/// the highlight would be "dehazed" (`t` about 0.5 on it); its airlight makes up a few %
-/// of the frame's light on average, below `min_airlight_share`, so the frame is left as
-/// it is, with a warning.
+/// A haze-free frame (t = 1) with a small glossy highlight polarized along the airlight's
+/// angle, which the airlight's estimator takes for the sky (the most polarized region) and
+/// everything polarized like it for airlight. Read as haze, the highlight would be
+/// "dehazed"; its airlight makes up a small share of the frame's light, below
+/// `min_airlight_share`, so the frame is left as it is, with a warning.
 #[test]
 fn haze_free_frame_with_a_polarized_highlight_is_left_unchanged() {
     let mut scene = Haze::standard(0, 0.0);
@@ -298,7 +297,7 @@ fn a_hazy_frame_is_not_taken_for_a_haze_free_one() {
     let scene = Haze::standard(16, 0.3);
     let out = dehaze(&scene.observation(), &DehazeOptions::default()).unwrap();
     assert!(!out.warnings.iter().any(|w| w.contains("no haze found")));
-    // Its true airlight share, mean(1 - t), is 0.54, far above the default bar.
+    // Its true airlight share, mean(1 - t), is far above the default bar.
     let share = scene.t.iter().map(|t| 1.0 - t).sum::<f32>() / scene.t.len() as f32;
     assert!(share > 3.0 * polar_dehaze::MIN_AIRLIGHT_SHARE, "{share}");
 }

@@ -58,7 +58,7 @@ pub struct TaskArgs {
     /// Dehazing by polarization leaves a frame unchanged (with a warning) where the airlight
     /// it finds makes up less than this share of the light on average: a haze-free frame's
     /// glossy highlights would otherwise be read as thin haze. 0 dehazes every frame.
-    #[arg(long, value_name = "SHARE", default_value_t = polar_dehaze::MIN_AIRLIGHT_SHARE, value_parser = parse_share)]
+    #[arg(long, value_name = "SHARE", default_value_t = polar_dehaze::MIN_AIRLIGHT_SHARE, value_parser = parse_share, allow_negative_numbers = true)]
     pub dehaze_min_airlight: f32,
     /// Material classification by k nearest neighbours with this model file (made by
     /// `polar-vision train material`), or `builtin` for the model shipped with the program

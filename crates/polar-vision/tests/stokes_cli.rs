@@ -271,6 +271,19 @@ fn truncated_non_png_missing_input_and_bad_arguments() {
         "unknown demosaicing method `cubic`",
     );
     fails_with(&["stokes", p(&good)], "--out");
+    for bad in ["1.5", "-0.1", "a lot"] {
+        fails_with(
+            &[
+                "run",
+                p(&good),
+                "--out",
+                p(&out),
+                "--dehaze-min-airlight",
+                bad,
+            ],
+            "--dehaze-min-airlight",
+        );
+    }
     // --out naming a file is rejected before any work.
     fails_with(&["stokes", p(&good), "--out", p(&good)], "not a folder");
     assert!(
