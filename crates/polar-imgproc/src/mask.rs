@@ -17,9 +17,57 @@ use crate::Error;
 /// computed on byte run distances (16 pixels per SIMD lane group) where the ellipse is
 /// narrower than 509 pixels.
 pub fn close_open(m: &[bool], w: usize, h: usize, k: usize) -> Result<Vec<bool>, Error> {
+    Ok(closed_and_opened(m, w, h, k)?.1)
+}
+
+/// [`close_open`], except that the thin parts of the closing, those the opening drops,
+/// stay where they touch what the opening keeps, hold at least `k²` pixels and `m` covers
+/// at least `min_density` of them (each 8-connected part judged on its own): a line of `m`
+/// broken by short gaps (an outline drawn in dashes), which the closing joins and the
+/// opening drops as narrower than `k`, stays with the blob it leads from; a chain the
+/// closing draws through scattered specks, mostly gaps, goes, and so does a part smaller
+/// than the element, a bump of the blob's outline rather than a line. `min_density` above 1
+/// keeps nothing more.
+pub fn close_open_keeping_lines(
+    m: &[bool],
+    w: usize,
+    h: usize,
+    k: usize,
+    min_density: f32,
+) -> Result<Vec<bool>, Error> {
+    let (closed, opened) = closed_and_opened(m, w, h, k)?;
+    let thin: Vec<bool> = closed.iter().zip(&opened).map(|(&c, &o)| c && !o).collect();
+    let (lab, n) = components(&thin, w, h)?;
+    let touching = grown(&opened, w, h, 1)?;
+    // Per thin part: whether it touches the opening's pixels, its pixels, those in `m`.
+    let (mut touches, mut all, mut on) =
+        (vec![false; n + 1], vec![0usize; n + 1], vec![0usize; n + 1]);
+    for (k, &l) in lab.iter().enumerate().filter(|&(_, &l)| l > 0) {
+        let c = l as usize;
+        touches[c] |= touching[k];
+        all[c] += 1;
+        on[c] += usize::from(m[k]);
+    }
+    let keep: Vec<bool> = (0..=n)
+        .map(|c| {
+            c > 0 && touches[c] && all[c] >= k * k && on[c] as f32 >= min_density * all[c] as f32
+        })
+        .collect();
+    Ok((0..w * h)
+        .map(|k| opened[k] || keep[lab[k] as usize])
+        .collect())
+}
+
+/// The closing of `m` by an ellipse of diameter `k` and that closing's opening.
+fn closed_and_opened(
+    m: &[bool],
+    w: usize,
+    h: usize,
+    k: usize,
+) -> Result<(Vec<bool>, Vec<bool>), Error> {
     check_kernel(k, k)?;
     if k / 2 >= usize::from(u8::MAX) {
-        return grey_close_open(m, w, h, k);
+        return grey_closed_and_opened(m, w, h, k);
     }
     let element: Vec<Offsets> = runs(MorphShape::Ellipse, k, k)
         .iter()
@@ -43,18 +91,29 @@ pub fn close_open(m: &[bool], w: usize, h: usize, k: usize) -> Result<Vec<bool>,
         &element,
         false,
     );
-    Ok(opened)
+    Ok((closed, opened))
 }
 
 /// `close` then `open` with [`MorphShape::Ellipse`] of diameter `k` on the 0/1 image of
 /// `m` (out-of-image pixels ignored), thresholded at 0.5.
 pub fn grey_close_open(m: &[bool], w: usize, h: usize, k: usize) -> Result<Vec<bool>, Error> {
+    Ok(grey_closed_and_opened(m, w, h, k)?.1)
+}
+
+/// [`closed_and_opened`] with the grey-scale operators.
+fn grey_closed_and_opened(
+    m: &[bool],
+    w: usize,
+    h: usize,
+    k: usize,
+) -> Result<(Vec<bool>, Vec<bool>), Error> {
     let src = Gray::from_vec(w, h, m.iter().map(|&b| f32::from(u8::from(b))).collect())
         .expect("mask size");
     let (mut a, mut b) = (Gray::new(w, h), Gray::new(w, h));
     close(&src, &mut a, MorphShape::Ellipse, k, k)?;
     open(&a, &mut b, MorphShape::Ellipse, k, k)?;
-    Ok(b.as_slice().iter().map(|&v| v > 0.5).collect())
+    let set = |g: &Gray<f32>| g.as_slice().iter().map(|&v| v > 0.5).collect();
+    Ok((set(&a), set(&b)))
 }
 
 /// One row of a structuring element that contains its centre column: row offset `dy`
@@ -666,9 +725,24 @@ pub fn morph_size(w: usize, h: usize) -> usize {
 /// The mask pipeline: close then open ([`morph_size`]), fill holes, drop components
 /// under 1/2000 of the image (at least 4 pixels).
 pub fn clean(seed: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
-    let m = close_open(seed, w, h, morph_size(w, h))?;
-    let m = fill_holes(&m, w, h)?;
-    remove_small(&m, w, h, (w * h / 2000).max(4))
+    filled_without_specks(&close_open(seed, w, h, morph_size(w, h))?, w, h)
+}
+
+/// [`clean`] with [`close_open_keeping_lines`] for the closing and opening.
+pub fn clean_keeping_lines(
+    seed: &[bool],
+    w: usize,
+    h: usize,
+    min_density: f32,
+) -> Result<Vec<bool>, Error> {
+    let m = close_open_keeping_lines(seed, w, h, morph_size(w, h), min_density)?;
+    filled_without_specks(&m, w, h)
+}
+
+/// `m` with its holes filled and without components under 1/2000 of the image (at least 4
+/// pixels).
+fn filled_without_specks(m: &[bool], w: usize, h: usize) -> Result<Vec<bool>, Error> {
+    remove_small(&fill_holes(m, w, h)?, w, h, (w * h / 2000).max(4))
 }
 
 #[cfg(test)]
@@ -959,6 +1033,64 @@ mod tests {
                 assert_eq!(
                     close_open(&m, w, h, k).unwrap(),
                     grey_close_open(&m, w, h, k).unwrap(),
+                    "{w}x{h}, k = {k}, density {density}"
+                );
+            }
+        }
+    }
+
+    /// A blob with a dashed line (3 pixels high, dashes of 6 with gaps of 2) leading right
+    /// from it, a chain of 4x2 specks 4 pixels apart leading down from it, and a dashed line
+    /// on its own: the closing (9) joins each into one band that the opening drops.
+    fn blob_with_a_line_and_a_chain() -> (Vec<bool>, usize, usize) {
+        let (w, h) = (96, 72);
+        let m = (0..w * h)
+            .map(|k| {
+                let (x, y) = (k % w, k / w);
+                let blob = (x as f32 - 20.0).hypot(y as f32 - 20.0) <= 12.0;
+                let dashes = |x: usize| x % 8 < 6;
+                let line = (19..22).contains(&y) && (30..90).contains(&x) && dashes(x);
+                let chain = (18..22).contains(&x) && (30..70).contains(&y) && y % 6 < 2;
+                let lone = (60..63).contains(&y) && (40..90).contains(&x) && dashes(x);
+                blob || line || chain || lone
+            })
+            .collect();
+        (m, w, h)
+    }
+
+    #[test]
+    fn dashed_line_from_a_blob_stays_a_chain_of_specks_goes() {
+        let (m, w, h) = blob_with_a_line_and_a_chain();
+        let at = |out: &[bool], x: usize, y: usize| out[y * w + x];
+        let (line, chain, lone) = ((60, 20), (19, 50), (60, 61));
+        let plain = close_open(&m, w, h, 9).unwrap();
+        assert!(at(&plain, 20, 20) && !at(&plain, line.0, line.1));
+        let kept = close_open_keeping_lines(&m, w, h, 9, 0.7).unwrap();
+        assert!(
+            at(&kept, 20, 20) && at(&kept, line.0, line.1),
+            "the line goes"
+        );
+        assert!(!at(&kept, chain.0, chain.1), "the chain stays");
+        assert!(!at(&kept, lone.0, lone.1), "the line on its own stays");
+        let all = close_open_keeping_lines(&m, w, h, 9, 0.0).unwrap();
+        assert!(at(&all, chain.0, chain.1) && !at(&all, lone.0, lone.1));
+    }
+
+    #[test]
+    fn keeping_lines_past_full_density_is_close_open() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for (w, h, k) in [(1, 1, 3), (40, 31, 5), (64, 48, 9)] {
+            for density in [5u64, 30, 50, 80] {
+                let m: Vec<bool> = (0..w * h).map(|_| next() % 100 < density).collect();
+                assert_eq!(
+                    close_open_keeping_lines(&m, w, h, k, 1.5).unwrap(),
+                    close_open(&m, w, h, k).unwrap(),
                     "{w}x{h}, k = {k}, density {density}"
                 );
             }

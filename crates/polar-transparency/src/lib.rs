@@ -245,7 +245,7 @@ pub fn detect(
         }
     };
     let seed = border_from_inside(seed, w, h);
-    let m = polar_imgproc::mask::clean(&seed, w, h)?;
+    let m = polar_imgproc::mask::clean_keeping_lines(&seed, w, h, LINE_DENSITY)?;
     let m = polar_imgproc::mask::remove_small(&m, w, h, MIN_WINDOWS * cues::WINDOW.pow(2))?;
     let m = lit_hulls(obs, m)?;
     let m = without_depolarized_rim(&m, &pixel_dolp, w, h)?;
@@ -258,6 +258,13 @@ pub fn detect(
         noise_floor: bar.noise_floor.then_some(bar.value),
     })
 }
+
+/// The least share of a thin part of the closed seed (a line the cleaning's opening would
+/// drop) that seed pixels must cover for it to stay with the region it leads from
+/// ([`polar_imgproc::mask::close_open_keeping_lines`]): a glass edge seen at grazing
+/// incidence is polarized along its length and its seed is a dashed line; a chain the
+/// closing draws through a floor's noise specks is mostly gaps.
+pub const LINE_DENSITY: f32 = 0.7;
 
 /// Seeds this close to the frame's edge (pixels) are not judged by their own cues but
 /// take the nearest judged pixel's verdict: there the median and the averaging window
