@@ -1,7 +1,7 @@
 //! Binary masks as `bool` planes (row-major, `w x h`): closing and opening (equal to the
-//! grey-scale operators on 0/1 images), hole filling and small-component removal with the labelling,
-//! splitting at narrow necks, convex hulls per component or over the arcs of one broken
-//! outline; the clean-up the segmenting tasks (material regions, transparency masks) share.
+//! grey-scale operators on 0/1 images; or keeping the dashed lines the opening would drop),
+//! hole filling and small-component removal with the labelling, splitting at narrow necks,
+//! convex hulls per component or over the arcs of one broken outline; the clean-up the segmenting tasks (material regions, transparency masks) share.
 
 use crate::label::Forest;
 use crate::morph::{check_kernel, runs};
@@ -42,11 +42,11 @@ pub fn close_open_keeping_lines(
     // Per thin part: whether it touches the opening's pixels, its pixels, those in `m`.
     let (mut touches, mut all, mut on) =
         (vec![false; n + 1], vec![0usize; n + 1], vec![0usize; n + 1]);
-    for (k, &l) in lab.iter().enumerate().filter(|&(_, &l)| l > 0) {
+    for (i, &l) in lab.iter().enumerate().filter(|&(_, &l)| l > 0) {
         let c = l as usize;
-        touches[c] |= touching[k];
+        touches[c] |= touching[i];
         all[c] += 1;
-        on[c] += usize::from(m[k]);
+        on[c] += usize::from(m[i]);
     }
     let keep: Vec<bool> = (0..=n)
         .map(|c| {
@@ -54,7 +54,7 @@ pub fn close_open_keeping_lines(
         })
         .collect();
     Ok((0..w * h)
-        .map(|k| opened[k] || keep[lab[k] as usize])
+        .map(|i| opened[i] || keep[lab[i] as usize])
         .collect())
 }
 
@@ -1008,18 +1008,22 @@ mod tests {
         );
     }
 
+    /// Marsaglia's xorshift64 from `state` (non-zero): pseudo-random test masks.
+    fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        }
+    }
+
     /// The run-distance closing-opening equals the grey-scale one exactly, on
     /// pseudo-random masks of several densities, sizes below and above the element, odd
     /// and even diameters, up to the widest the byte distances take.
     #[test]
     fn close_open_equals_the_grey_scale_operators() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
         for (w, h, k) in [
             (1, 1, 3),
             (5, 3, 7),
@@ -1068,23 +1072,18 @@ mod tests {
         let kept = close_open_keeping_lines(&m, w, h, 9, 0.7).unwrap();
         assert!(
             at(&kept, 20, 20) && at(&kept, line.0, line.1),
-            "the line goes"
+            "the line is dropped"
         );
-        assert!(!at(&kept, chain.0, chain.1), "the chain stays");
-        assert!(!at(&kept, lone.0, lone.1), "the line on its own stays");
+        assert!(!at(&kept, chain.0, chain.1), "the chain is kept");
+        assert!(!at(&kept, lone.0, lone.1), "the line on its own is kept");
         let all = close_open_keeping_lines(&m, w, h, 9, 0.0).unwrap();
         assert!(at(&all, chain.0, chain.1) && !at(&all, lone.0, lone.1));
     }
 
+    /// No thin part is covered beyond all its pixels: nothing is kept that the opening drops.
     #[test]
     fn keeping_lines_past_full_density_is_close_open() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
         for (w, h, k) in [(1, 1, 3), (40, 31, 5), (64, 48, 9)] {
             for density in [5u64, 30, 50, 80] {
                 let m: Vec<bool> = (0..w * h).map(|_| next() % 100 < density).collect();
