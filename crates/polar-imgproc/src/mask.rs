@@ -1,7 +1,8 @@
 //! Binary masks as `bool` planes (row-major, `w x h`): closing and opening (equal to the
 //! grey-scale operators on 0/1 images; or keeping the dashed lines the opening would drop),
 //! hole filling and small-component removal with the labelling, splitting at narrow necks,
-//! convex hulls per component or over the arcs of one broken outline; the clean-up the segmenting tasks (material regions, transparency masks) share.
+//! convex hulls per component or over the arcs of one broken outline; the clean-up the
+//! segmenting tasks (material regions, transparency masks) share.
 
 use crate::label::Forest;
 use crate::morph::{check_kernel, runs};
