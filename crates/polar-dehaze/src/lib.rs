@@ -308,8 +308,8 @@ pub fn dehaze(obs: &Observation, opts: &DehazeOptions) -> Result<Dehazed, Dehaze
     };
     warnings.extend(estimate.warnings.iter().cloned());
     let mut t = refine::refine(&input, &estimate.raw_t, opts, estimate.guided_eps)?;
-    let share = airlight_share(&t, &input.valid);
-    if opts.method == Method::Polarization && share < opts.min_airlight_share {
+    let share = (opts.method == Method::Polarization).then(|| airlight_share(&t, &input.valid));
+    if let Some(share) = share.filter(|&s| s < opts.min_airlight_share) {
         warnings.push(format!(
             "no haze found: the airlight makes up {share:.3} of the light on average, \
              below min_airlight_share {}: image left unchanged (t = 1)",
