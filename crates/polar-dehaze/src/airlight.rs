@@ -23,13 +23,16 @@
 //!    `A_inf` and `p` on the sky).
 //! 4. **`p` and `A_inf` over the frame** (`varying_airlight`, [`SkyField`]). Neither is
 //!    one number: `p` follows the scattering angle, and the sky is brighter towards the
-//!    sun. Blocks with `P / S0 >= SKY_LEVEL p` and `P / p >= SKY_LEVEL A_inf` are sky
-//!    candidates; an upper-envelope plane of their `P / S0`, fitted inside extended
-//!    regions of them (a strongly polarized highlight is no sky), picks those at infinity; a
-//!    plane fitted to them gives `p(x, y)`, and the upper-envelope plane of the airlight
-//!    of those inside extended regions of candidates and near the sky's brightness gives
-//!    `A_inf(x, y)` (both clamped to the range seen). Needs [`MIN_SKY_BLOCKS`] of them;
-//!    otherwise 1.-3. stand.
+//!    sun. Blocks whose `P / S0` and `P` reach [`SKY_LEVEL`] of the levels under `p` and
+//!    `p A_inf` (the quantiles of 2.-3. less the height at which the same quantiles of
+//!    noise lie above its mean, `noise`) are sky candidates; an upper-envelope plane of
+//!    their `P / S0`, fitted inside extended regions of them (a strongly polarized
+//!    highlight is no sky) and lowered by the noise's height alike, picks those at
+//!    infinity. Those inside extended regions of candidates and near the sky's brightness
+//!    are the sky, where all the light is airlight: the upper-envelope plane of their S0
+//!    gives `A_inf(x, y)` and a plane fitted to their `P / S0` gives `p(x, y)` (both
+//!    clamped to the range seen). Needs [`MIN_SKY_BLOCKS`] at infinity; otherwise 1.-3.
+//!    stand.
 //!
 //! Failure modes (reported as warnings where they can be detected):
 //! - no sky and no black object in view: `P / S0 < p` everywhere, so `p` is underestimated
@@ -48,14 +51,16 @@
 //!   scattering polarizes least) is no candidate, and the plane of `p`, clamped to the
 //!   range seen, stays too high there: `t` too high, the sky there left hazy;
 //! - sensor or Monte Carlo noise comparable to `p` in a block's `P / S0` (weak airlight
-//!   polarization on a small image) raises both envelopes: `p` and `A_inf` too high, `t`
-//!   too high where the airlight is weak;
+//!   polarization on a small image) raises the envelope of `P / S0`. The sky field takes
+//!   the noise's share off; 2.-3. (no sky field) do not: `p` too high, `A_inf = P / p` too
+//!   low, `t` too high where the airlight is weak (on a haze-free frame a lower `p` would
+//!   read more of the objects' own polarization as airlight);
 //! - no sky region large enough for [`MIN_SKY_BLOCKS`] interior blocks: one `p` and
 //!   `A_inf` (a sky much brighter on one side then leaves `t > 0` on the darker side);
 //! - airlight polarization at the noise level: `p` is then noise; [`crate::polarization`]
 //!   falls back when `p < min_airlight_dolp`.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
 use nalgebra::{DMatrix, DVector};
 use polar_image::{Gray, quantile};
@@ -90,7 +95,7 @@ pub struct AirlightEstimate {
     pub field: AngleField,
     /// `p` varying over the frame, where enough sky is seen.
     pub sky: Option<SkyField>,
-    /// Fraction of the blocks that look like sky (`P / S0 >= 0.8 p` and `A >= 0.8 A_inf`).
+    /// Fraction of the blocks that look like sky (the sky field's candidates, module doc).
     pub sky_fraction: f32,
     /// Number of blocks used.
     pub blocks: usize,
@@ -363,33 +368,43 @@ pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
     let blocks = Blocks::new(input);
     let field = fit_angle_field(&blocks)?;
     let n = blocks.len();
-    let proj: Vec<f32> = (0..n)
+    let (proj, across): (Vec<f32>, Vec<f32>) = (0..n)
         .map(|i| {
             let (c, s) = field.direction(blocks.x[i], blocks.y[i]);
-            (f64::from(blocks.s1[i]) * c + f64::from(blocks.s2[i]) * s) as f32
+            let (s1, s2) = (f64::from(blocks.s1[i]), f64::from(blocks.s2[i]));
+            ((s1 * c + s2 * s) as f32, (s2 * c - s1 * s) as f32)
         })
-        .collect();
-    let ratio: Vec<f32> = (0..n)
-        .filter(|&i| blocks.s0[i] >= DARK_LEVEL)
-        .map(|i| proj[i] / blocks.s0[i])
-        .collect();
-    let p = quantile(ratio.iter().copied(), ENVELOPE_QUANTILE)?.clamp(0.0, 1.0);
+        .unzip();
+    let bright: Vec<usize> = (0..n).filter(|&i| blocks.s0[i] >= DARK_LEVEL).collect();
+    let ratio = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
+    let p = quantile(bright.iter().map(|&i| ratio(i) as f32), ENVELOPE_QUANTILE)?.clamp(0.0, 1.0);
     let airlight: Vec<f32> = proj.iter().map(|&v| v / p).collect();
     let a_inf = if p > 0.0 {
         quantile(airlight.iter().copied(), AIRLIGHT_QUANTILE)?
     } else {
         0.0
     };
-    let sky: Vec<usize> = (0..n)
+    // Noise raises both quantiles above the sky's level: the candidates are judged against
+    // the levels (without a sky field the quantiles stand, module doc).
+    let all: Vec<usize> = (0..n).collect();
+    let ratio_level = f64::from(p)
+        - Z_QUANTILE
+            * noise(&blocks, &across, &bright, &|i| {
+                1.0 / f64::from(blocks.s0[i])
+            });
+    let polarized_level =
+        f64::from(p * a_inf) - Z_QUANTILE_HIGH * noise(&blocks, &across, &all, &|_| 1.0);
+    let sky: Vec<usize> = bright
+        .iter()
+        .copied()
         .filter(|&i| {
             p > 0.0
-                && blocks.s0[i] >= DARK_LEVEL
-                && proj[i] >= SKY_LEVEL * p * blocks.s0[i]
-                && airlight[i] >= SKY_LEVEL * a_inf
+                && ratio(i) >= f64::from(SKY_LEVEL) * ratio_level
+                && f64::from(proj[i]) >= f64::from(SKY_LEVEL) * polarized_level
         })
         .collect();
     let sky_field = (varying && sky.len() >= MIN_SKY_BLOCKS)
-        .then(|| SkyField::fit(&blocks, &proj, &sky))
+        .then(|| SkyField::fit(&blocks, &proj, &across, &sky))
         .flatten()
         .filter(|f| f.dolp_range.0 > 0.0);
     let (p, a_inf) = match &sky_field {
@@ -404,6 +419,40 @@ pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
         sky_fraction: sky.len() as f32 / n.max(1) as f32,
         blocks: n,
     })
+}
+
+/// How far an upper quantile or envelope of Gaussian noise lies above its level, in
+/// standard deviations: the [`ENVELOPE_QUANTILE`] and [`AIRLIGHT_QUANTILE`] quantiles and
+/// the [`ENVELOPE_EXPECTILE`] expectile of the standard normal.
+const Z_QUANTILE: f64 = 2.326;
+const Z_QUANTILE_HIGH: f64 = 2.576;
+const Z_EXPECTILE: f64 = 1.717;
+/// Half-width, in noise deviations, of the band around the envelope of `P / S0` whose
+/// blocks count as at infinity (where wider than [`INFINITY_TOLERANCE`]).
+const NOISE_BAND: f64 = 2.0;
+
+/// The block means' noise, read from the polarization across the airlight's angle `Q`
+/// (`across`): airlight has none, so on the blocks an envelope rests on (sky) `Q` is noise
+/// with the deviation of the projection `P` along it, plus the angle field's misfit, which
+/// is smooth and drops out of the differences between grid neighbours. Returns the robust
+/// deviation `MAD_TO_SIGMA · median |d| / √2` of `d = Q_i scale(i) − Q_j scale(j)` over the
+/// neighbouring blocks `i`, `j` of `idx`: the noise of the value `P_i scale(i)`; 0 without
+/// such pairs.
+fn noise(blocks: &Blocks, across: &[f32], idx: &[usize], scale: &dyn Fn(usize) -> f64) -> f64 {
+    let at: HashMap<(usize, usize), usize> = idx.iter().map(|&i| (blocks.cell[i], i)).collect();
+    let q = |i: usize| f64::from(across[i]) * scale(i);
+    let diffs: Vec<f32> = idx
+        .iter()
+        .flat_map(|&i| {
+            let (x, y) = blocks.cell[i];
+            [(x + 1, y), (x, y + 1)]
+                .into_iter()
+                .filter_map(|c| at.get(&c).map(|&j| (q(i) - q(j)).abs() as f32))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    f64::from(crate::refine::MAD_TO_SIGMA) * f64::from(quantile(diffs, 0.5).unwrap_or(0.0))
+        / std::f64::consts::SQRT_2
 }
 
 /// Blocks whose airlight fraction `P / (p S0)` and airlight `P / p` both reach this
@@ -430,14 +479,14 @@ pub const SKY_AIRLIGHT_SHARE: f64 = 0.7;
 /// `p` depend on the angle to the sun, which turns across a wide field of view.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SkyField {
-    /// Plane coefficients `[a, b, c]` of `p`.
+    /// Plane coefficients `[a, b, c]` of `p` over the sky blocks.
     pub dolp: [f64; 3],
     /// Range of the sky blocks' `P / S0`.
     pub dolp_range: (f64, f64),
-    /// Plane coefficients `[a, b, c]` of `A_inf`: the upper envelope of the sky blocks'
-    /// airlight `P / p(x, y)` (at infinity all the light is airlight).
+    /// Plane coefficients `[a, b, c]` of `A_inf`: the upper envelope of the sky blocks' S0
+    /// (at infinity all the light is airlight).
     pub airlight: [f64; 3],
-    /// Range of the sky blocks' airlight.
+    /// Range of the sky blocks' S0.
     pub airlight_range: (f64, f64),
     /// Number of blocks taken as infinity.
     pub blocks: usize,
@@ -449,25 +498,31 @@ impl SkyField {
     /// upper-envelope plane of `P / S0` ([`envelope_plane`]), fitted to those inside
     /// extended regions of them ([`interior`]): a polarized highlight on a glossy object,
     /// aligned with the airlight and stronger than it, is too small to hold a block there
-    /// and would pull the envelope up. The candidates within [`INFINITY_TOLERANCE`] of the
-    /// envelope, either side, are taken as infinity, and the plane of `p` is refitted to
-    /// them by least squares. The airlight `A = P / p(x, y)` is at most `A_inf`, with
-    /// equality at infinity, so `A_inf` is the upper-envelope plane of `A` over those
-    /// blocks inside extended regions of candidates and bright enough ([`bright_inner`]),
-    /// and in the top cluster of `A` ([`upper_blocks`]): a black object also has
-    /// `P / S0 = p`, at any distance, and a ramp of them down a hazy slope would tilt the
-    /// plane. `None` with fewer than 3 such blocks (then one `p` and `A_inf` over the frame).
-    fn fit(blocks: &Blocks, proj: &[f32], candidates: &[usize]) -> Option<Self> {
+    /// and would pull the envelope up. With noise the envelope lies [`Z_EXPECTILE`] noise
+    /// deviations ([`noise`]) above the level of `P / S0` at infinity, and is lowered by
+    /// that much; the candidates within [`INFINITY_TOLERANCE`] of it, either side (or
+    /// within [`NOISE_BAND`] deviations, where wider), are taken as infinity. At infinity S0
+    /// is all airlight, `A_inf`, measured there on S0 rather than on `P / p`, whose noise is
+    /// `1 / p` times larger and would raise its upper envelope. So the sky is the blocks at
+    /// infinity inside extended regions of candidates and bright enough ([`bright_inner`]),
+    /// in the top cluster of S0 ([`upper_blocks`]): a black object also has `P / S0 = p`, at
+    /// any distance, and a ramp of them down a hazy slope would tilt the planes. `A_inf` is
+    /// the upper-envelope plane of their S0, `p` the least-squares plane of their `P / S0`
+    /// (unbiased by noise). `None` with fewer than 3 such blocks (then one `p` and `A_inf`
+    /// over the frame).
+    fn fit(blocks: &Blocks, proj: &[f32], across: &[f32], candidates: &[usize]) -> Option<Self> {
         let eval = |c: &[f64; 3], i: usize| c[0] + c[1] * blocks.x[i] + c[2] * blocks.y[i];
         let dolp = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
         let inner = interior(blocks, candidates);
-        let env = envelope_plane(blocks, &inner, &dolp)?;
+        let dolp_noise = noise(blocks, across, &inner, &|i| 1.0 / f64::from(blocks.s0[i]));
+        let mut env = envelope_plane(blocks, &inner, &dolp)?;
+        env[0] -= Z_EXPECTILE * dolp_noise;
         let inf: Vec<usize> = candidates
             .iter()
             .copied()
             .filter(|&i| {
                 let e = eval(&env, i);
-                (dolp(i) - e).abs() <= INFINITY_TOLERANCE * e
+                (dolp(i) - e).abs() <= (INFINITY_TOLERANCE * e).max(NOISE_BAND * dolp_noise)
             })
             .collect();
         if inf.len() < MIN_SKY_BLOCKS {
@@ -479,18 +534,17 @@ impl SkyField {
                     (lo.min(v(i)), hi.max(v(i)))
                 })
         };
-        let dolp_plane = plane_fit(blocks, &inf, &dolp, &vec![1.0; inf.len()])?;
-        let dolp_range = range(&inf, &dolp);
-        let airlight = |i: usize| {
-            f64::from(proj[i]) / plane(&dolp_plane, dolp_range, blocks.x[i], blocks.y[i])
-        };
-        // Black objects pass the `p` test at any distance, but their airlight is below A_inf.
-        let top = upper_blocks(blocks, &bright_inner(&inner, &inf, &airlight)?, &airlight)?;
+        // Black objects pass the `p` test at any distance, but their S0, all airlight, is
+        // below A_inf.
+        let s0 = |i: usize| f64::from(blocks.s0[i]);
+        let top = upper_blocks(blocks, &bright_inner(&inner, &inf, &s0)?, &s0)?;
+        let dolp_plane = plane_fit(blocks, &top, &dolp, &vec![1.0; top.len()])?;
+        let dolp_range = range(&top, &dolp);
         Some(Self {
             dolp: dolp_plane,
             dolp_range,
-            airlight: envelope_plane(blocks, &top, &airlight)?,
-            airlight_range: range(&top, &airlight),
+            airlight: envelope_plane(blocks, &top, &s0)?,
+            airlight_range: range(&top, &s0),
             blocks: inf.len(),
         })
     }
@@ -541,7 +595,7 @@ fn envelope_plane(blocks: &Blocks, idx: &[usize], v: &dyn Fn(usize) -> f64) -> O
 }
 
 /// The blocks at infinity (`inf`) inside extended regions of the sky candidates (`inner`,
-/// their [`interior`]) whose airlight `v` is at least [`SKY_AIRLIGHT_SHARE`] of the
+/// their [`interior`]) whose airlight `v` (S0) is at least [`SKY_AIRLIGHT_SHARE`] of the
 /// [`AIRLIGHT_QUANTILE`] of theirs. The regions are the candidates', not those of `inf`:
 /// where noise is comparable to the spread of `P / S0` over the sky, it picks which sky
 /// blocks reach the envelope, scattered, and few of them have all four neighbours among

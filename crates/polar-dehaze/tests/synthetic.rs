@@ -204,6 +204,31 @@ fn noisy_sky_still_gets_a_varying_airlight() {
 }
 
 #[test]
+fn weak_airlight_polarization_is_not_raised_by_noise() {
+    // A weakly polarized airlight (p = 0.06) and noisy S1, S2 (uniform, up to 0.12 S0 per
+    // pixel: a standard deviation of 0.023 in `P / S0` over a 3x3 block, 0.4 p). An upper
+    // envelope of the blocks' `P / S0` then lies 1.7 to 2.3 deviations above p, near 0.11:
+    // the sky field must take the noise's share off, and the transmission on the ground
+    // follow p. The tolerance, a quarter of p, allows for the lower tail of the sky blocks'
+    // noise that the candidates' bar on `P / S0` cuts off, which raises the mean of those
+    // kept.
+    let scene = Haze::standard(24, 0.06);
+    let (s0, mut s1, mut s2) = scene.planes();
+    for (seed, plane) in [(31, &mut s1), (32, &mut s2)] {
+        for (k, n) in noise(seed, plane.len()).into_iter().enumerate() {
+            plane[k] += 0.12 * s0[k] * n;
+        }
+    }
+    let obs = observation(scene.w, scene.h, s0, s1, s2);
+    let out = dehaze_default(&obs, true);
+    let p = out.airlight_dolp;
+    assert!((p - 0.06).abs() < 0.015, "p {p}");
+    let ground = |k: usize| k / scene.w >= 40;
+    let t = mean_err(out.transmission.as_slice(), &scene.t, ground);
+    assert!(t < 0.1, "t error {t}");
+}
+
+#[test]
 fn haze_free_unpolarized_input_is_left_unchanged_with_identity_fallback() {
     let mut scene = Haze::standard(0, 0.0);
     scene.t.iter_mut().for_each(|t| *t = 1.0);
