@@ -378,9 +378,8 @@ pub fn estimate(input: &Normalized, varying: bool) -> Option<AirlightEstimate> {
     let bright: Vec<usize> = (0..n).filter(|&i| blocks.s0[i] >= DARK_LEVEL).collect();
     let ratio = |i: usize| f64::from(proj[i]) / f64::from(blocks.s0[i]);
     let p = quantile(bright.iter().map(|&i| ratio(i) as f32), ENVELOPE_QUANTILE)?.clamp(0.0, 1.0);
-    let airlight: Vec<f32> = proj.iter().map(|&v| v / p).collect();
     let a_inf = if p > 0.0 {
-        quantile(airlight.iter().copied(), AIRLIGHT_QUANTILE)?
+        quantile(proj.iter().map(|&v| v / p), AIRLIGHT_QUANTILE)?
     } else {
         0.0
     };

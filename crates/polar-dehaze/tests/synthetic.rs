@@ -388,6 +388,35 @@ fn unpolarized_airlight_falls_back_to_dark_channel_with_warning() {
     );
 }
 
+/// Unpolarized airlight under noisy S1, S2 (as in
+/// `weak_airlight_polarization_is_not_raised_by_noise`: a standard deviation of 0.023 in a
+/// 3x3 block's `P / S0`): the sky's `P / S0` is noise about 0, so the estimated `p` must
+/// stay within about one deviation of it (an upper quantile of the noise would read 0.05
+/// or more), and nothing is dehazed from noise: the frame either falls back or is left
+/// unchanged with a warning.
+#[test]
+fn unpolarized_airlight_under_noise_is_no_polarized_sky() {
+    let scene = Haze::standard(24, 0.0);
+    let (s0, mut s1, mut s2) = scene.planes();
+    for (seed, plane) in [(41, &mut s1), (42, &mut s2)] {
+        for (k, n) in noise(seed, plane.len()).into_iter().enumerate() {
+            plane[k] += 0.12 * s0[k] * n;
+        }
+    }
+    let obs = observation(scene.w, scene.h, s0, s1, s2);
+    let out = dehaze(&obs, &DehazeOptions::default()).unwrap();
+    assert!(all_finite(&out));
+    assert!(out.airlight_dolp < 0.03, "p {}", out.airlight_dolp);
+    let unchanged = out.transmission.as_slice().iter().all(|&t| t == 1.0);
+    assert!(
+        out.method == Method::DarkChannel || unchanged,
+        "{:?}, {:?}",
+        out.method,
+        out.warnings
+    );
+    assert!(!out.warnings.is_empty());
+}
+
 #[test]
 fn weak_airlight_polarization_below_threshold_falls_back() {
     let scene = Haze::standard(16, 0.01);
