@@ -128,6 +128,22 @@ fn polarization_with_sensor_noise_stays_close() {
 }
 
 /// `dehaze` with the default options, the airlight varying over the frame or not.
+/// The scene's observation with uniform noise of up to `amplitude` S0 per pixel added to S1
+/// and S2 (`seeds` for each).
+fn with_polarization_noise(
+    scene: &Haze,
+    seeds: [u64; 2],
+    amplitude: f32,
+) -> polar_sensor::Observation {
+    let (s0, mut s1, mut s2) = scene.planes();
+    for (seed, plane) in seeds.into_iter().zip([&mut s1, &mut s2]) {
+        for (k, n) in noise(seed, plane.len()).into_iter().enumerate() {
+            plane[k] += amplitude * s0[k] * n;
+        }
+    }
+    observation(scene.w, scene.h, s0, s1, s2)
+}
+
 fn dehaze_default(
     obs: &polar_sensor::Observation,
     varying_airlight: bool,
@@ -184,13 +200,7 @@ fn noisy_sky_still_gets_a_varying_airlight() {
     // and halve the t error of one A_inf, as without the noise.
     let mut scene = Haze::standard(24, 0.3);
     scene.a_tilt = 0.2;
-    let (s0, mut s1, mut s2) = scene.planes();
-    for (seed, plane) in [(21, &mut s1), (22, &mut s2)] {
-        for (k, n) in noise(seed, plane.len()).into_iter().enumerate() {
-            plane[k] += 0.1 * s0[k] * n;
-        }
-    }
-    let obs = observation(scene.w, scene.h, s0, s1, s2);
+    let obs = with_polarization_noise(&scene, [21, 22], 0.1);
     let interior = |k: usize| k / scene.w >= 40;
     let t_error = |varying_airlight| {
         let out = dehaze_default(&obs, varying_airlight);
@@ -213,13 +223,7 @@ fn weak_airlight_polarization_is_not_raised_by_noise() {
     // noise that the candidates' bar on `P / S0` cuts off, which raises the mean of those
     // kept.
     let scene = Haze::standard(24, 0.06);
-    let (s0, mut s1, mut s2) = scene.planes();
-    for (seed, plane) in [(31, &mut s1), (32, &mut s2)] {
-        for (k, n) in noise(seed, plane.len()).into_iter().enumerate() {
-            plane[k] += 0.12 * s0[k] * n;
-        }
-    }
-    let obs = observation(scene.w, scene.h, s0, s1, s2);
+    let obs = with_polarization_noise(&scene, [31, 32], 0.12);
     let out = dehaze_default(&obs, true);
     let p = out.airlight_dolp;
     assert!((p - 0.06).abs() < 0.015, "p {p}");
@@ -397,13 +401,7 @@ fn unpolarized_airlight_falls_back_to_dark_channel_with_warning() {
 #[test]
 fn unpolarized_airlight_under_noise_is_no_polarized_sky() {
     let scene = Haze::standard(24, 0.0);
-    let (s0, mut s1, mut s2) = scene.planes();
-    for (seed, plane) in [(41, &mut s1), (42, &mut s2)] {
-        for (k, n) in noise(seed, plane.len()).into_iter().enumerate() {
-            plane[k] += 0.12 * s0[k] * n;
-        }
-    }
-    let obs = observation(scene.w, scene.h, s0, s1, s2);
+    let obs = with_polarization_noise(&scene, [41, 42], 0.12);
     let out = dehaze(&obs, &DehazeOptions::default()).unwrap();
     assert!(all_finite(&out));
     assert!(out.airlight_dolp < 0.03, "p {}", out.airlight_dolp);
