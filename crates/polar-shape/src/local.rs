@@ -35,6 +35,12 @@
 //!    won the choice by a small margin, possibly the wrong reflection type; the average
 //!    keeps what the neighbours agree on, and pixels without measurable polarization
 //!    take their neighbours' shape.
+//! 5. Rim: near the silhouette the field's window sees only the object's inner, flatter
+//!    side, so its zenith falls short of the 90° a smooth occluding contour reaches. In
+//!    the outer part of an object ([`RIM_SINE`]) behind a curved outline
+//!    ([`RIM_CURVATURE`]; a straight outline may be a flat face's edge, a concave one a
+//!    hole's), the output's zenith cosine moves [`RIM_PULL`] of the way toward the
+//!    prior's where that is steeper, its azimuth kept.
 //!
 //! Concave regions are recovered only where smoothness carries the DoLP/AoLP evidence
 //! against the convex prior (the prior is weak away from the contour).
@@ -70,6 +76,16 @@ const CONTOUR_SIGMA: f64 = 2.0;
 /// How much farther (pixels) than the nearest boundary a verified contour may be for a
 /// pixel to keep its prior.
 const VERIFIED_SLACK: f64 = 1.0;
+/// The rim of step 5: the prior's zenith sine (`1 − D/R`) at least this, the outer fifth
+/// of the inscribed radius.
+pub const RIM_SINE: f64 = 0.8;
+/// Least curvature of the outline, times the object's inscribed radius `R`, for a rim of
+/// step 5: the flattest point of a 2:1 ellipse's outline (a circle's is 1).
+pub const RIM_CURVATURE: f64 = 0.25;
+/// Share of the way from the output's zenith cosine to the prior's taken on a rim.
+pub const RIM_PULL: f64 = 0.5;
+/// Gaussian sigma (pixels) of the outline's curvature.
+const CURVATURE_SIGMA: f64 = 1.5;
 
 /// The prior of step 1: a unit normal and a weight per pixel.
 pub struct Prior {
@@ -79,6 +95,8 @@ pub struct Prior {
     pub weight: Vec<f64>,
     /// The pixel's object is specular-dominated at its rim (`specular_rims`).
     pub specular_rim: Vec<bool>,
+    /// The pixel lies on a rim of step 5, where the output's zenith is raised.
+    pub rim: Vec<bool>,
 }
 
 /// Disambiguated normals of the foreground pixels.
@@ -113,6 +131,14 @@ pub fn disambiguate_with(cues: &Cues, fg: &[bool], prior: &Prior) -> Result<Esti
             (nc, kind, agree) if fg[k] && kind != ReflectionType::None && agree >= agreement => nc,
             // The field, zero off the foreground (smooth_field).
             _ => field[k],
+        })
+        .enumerate()
+        .map(|(k, nv)| {
+            if prior.rim[k] {
+                toward_prior_zenith(&cues.frame(k).d, &nv, &prior.normal[k])
+            } else {
+                nv
+            }
         })
         .collect();
     let confidence = (0..n)
@@ -238,6 +264,17 @@ fn choose_within(
     (n, kind, n.dot(reference))
 }
 
+/// `n` with its zenith cosine moved [`RIM_PULL`] of the way toward `prior`'s where that
+/// is steeper, its azimuth about the ray `d` kept (step 5).
+fn toward_prior_zenith(d: &Vector3<f64>, n: &Vector3<f64>, prior: &Vector3<f64>) -> Vector3<f64> {
+    let c = -d.dot(n);
+    let target = c.min(c + RIM_PULL * (-d.dot(prior) - c));
+    match (n + d * c).try_normalize(1e-9) {
+        Some(u) => -d * target + u * (1.0 - target * target).max(0.0).sqrt(),
+        None => *n,
+    }
+}
+
 /// The planes [`smooth_field`] blurs, allocated once for all iterations.
 struct FieldPlanes {
     weighted: [Gray<f32>; 3],
@@ -307,6 +344,7 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
             normal,
             weight: vec![0.0; n],
             specular_rim: vec![false; n],
+            rim: vec![false; n],
         });
     }
     let radius = component_max(fg, &dist, w, h)?;
@@ -326,8 +364,7 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
                 return (-f.d, 0.0);
             }
             let (dx, dy) = outward[k];
-            let r = radius[k].max(1.0);
-            let sin_z = (1.0 - (dist[k] - 0.5).max(0.0) / r).clamp(0.0, 1.0);
+            let sin_z = prior_sine(dist[k], radius[k]);
             let Some(out) = image_direction(&f, dx, dy).filter(|_| dx.hypot(dy) >= 1e-6) else {
                 return (-f.d, 0.0);
             };
@@ -340,11 +377,72 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
             )
         })
         .collect();
+    let curvature = outline_curvature(fg, &outward, w, h)?;
+    let rim = (0..n)
+        .map(|k| {
+            fg[k]
+                && prior_sine(dist[k], radius[k]) >= RIM_SINE
+                && curvature[k] * radius[k] >= RIM_CURVATURE
+        })
+        .collect();
     Ok(Prior {
         normal: out.iter().map(|v| v.0).collect(),
         weight: out.iter().map(|v| v.1).collect(),
         specular_rim: specular_rims(cues, fg, &dist, &outward)?,
+        rim,
     })
+}
+
+/// The prior's zenith sine `1 − D/R` at distance `dist` (pixels, from the pixel centre
+/// half a pixel inside the outline) in an object of inscribed radius `radius`.
+fn prior_sine(dist: f64, radius: f64) -> f64 {
+    (1.0 - (dist - 0.5).max(0.0) / radius.max(1.0)).clamp(0.0, 1.0)
+}
+
+/// Curvature of the outline nearest each foreground pixel (1/pixels, positive where it
+/// is convex): the divergence of the unit outward directions (a circle's level sets at
+/// radius `r` give `1/r`), averaged over the foreground by a Gaussian of
+/// [`CURVATURE_SIGMA`].
+fn outline_curvature(
+    fg: &[bool],
+    outward: &[(f64, f64)],
+    w: usize,
+    h: usize,
+) -> Result<Vec<f64>, ShapeError> {
+    let unit = |k: usize| {
+        let (x, y) = outward[k];
+        let m = x.hypot(y);
+        if m > 1e-9 { (x / m, y / m) } else { (0.0, 0.0) }
+    };
+    let div: Vec<f32> = (0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            if !fg[k] {
+                return 0.0;
+            }
+            let (x, y) = (k % w, k / w);
+            let dx = unit(y * w + (x + 1).min(w - 1)).0 - unit(y * w + x.saturating_sub(1)).0;
+            let dy = unit((y + 1).min(h - 1) * w + x).1 - unit(y.saturating_sub(1) * w + x).1;
+            (0.5 * (dx + dy)) as f32
+        })
+        .collect();
+    let weights: Vec<f32> = fg.iter().map(|&f| f32::from(u8::from(f))).collect();
+    let blur = |v: Vec<f32>| -> Result<Vec<f32>, ShapeError> {
+        let mut dst = Gray::new(w, h);
+        gaussian_blur(
+            &Gray::from_vec(w, h, v).expect("sized"),
+            &mut dst,
+            0,
+            CURVATURE_SIGMA,
+        )?;
+        Ok(dst.into_vec())
+    };
+    let (num, den) = (blur(div)?, blur(weights)?);
+    Ok(num
+        .iter()
+        .zip(&den)
+        .map(|(&a, &b)| if b > 0.0 { f64::from(a / b) } else { 0.0 })
+        .collect())
 }
 
 /// `true` on the pixels of each 8-connected object whose polarization lies across its
