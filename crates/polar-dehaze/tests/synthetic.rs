@@ -127,7 +127,6 @@ fn polarization_with_sensor_noise_stays_close() {
     assert!(et < 0.05, "mean |t error| {et}");
 }
 
-/// `dehaze` with the default options, the airlight varying over the frame or not.
 /// The scene's observation with uniform noise of up to `amplitude` S0 per pixel added to S1
 /// and S2 (`seeds` for each).
 fn with_polarization_noise(
@@ -144,6 +143,7 @@ fn with_polarization_noise(
     observation(scene.w, scene.h, s0, s1, s2)
 }
 
+/// `dehaze` with the default options, the airlight varying over the frame or not.
 fn dehaze_default(
     obs: &polar_sensor::Observation,
     varying_airlight: bool,
