@@ -9,7 +9,7 @@ mod common;
 // regressions. They are far from the task issues' targets, which the tasks do not reach
 // yet (docs/benchmarks.md has the figures on the larger dev set and on Mitsuba 3 scenes).
 
-/// Shape from polarization on the ci shape family: measured mean 16.4°, median 13.7°
+/// Shape from polarization on the ci shape family: measured mean 16.0°, median 13.5°
 /// (targets on the full suite: mean <= 10°, median <= 5°).
 const SFP_CI_MEAN_DEG: f64 = 22.0;
 /// See [`SFP_CI_MEAN_DEG`].

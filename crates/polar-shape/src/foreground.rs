@@ -19,9 +19,14 @@
 //! 4. of the edge-free interiors only object faces count (`object_faces`): those B
 //!    holds (a tenth of the ring around them is B: a face inside its coherent rim),
 //!    and those polarized above the background (median DoLP twice the background's: a
-//!    glossy face whose AoLP varies too fast for B); with the edges near them or near B.
-//!    Edges also enclose cast shadows and floor texture: they are no more polarized than
-//!    the floor, and B touches a shadow only along its contact line with the object. The
+//!    glossy face whose AoLP varies too fast for B), the background's DoLP scaled to the
+//!    face's brightness as noise scales, by `√(background / face)` where the face is
+//!    darker; with the edges near them or near B. Edges also enclose cast shadows and
+//!    floor texture: they are no more polarized than the floor, and B touches a shadow
+//!    only along its contact line with the object. A deep shadow's DoLP does rise above
+//!    the lit floor's, by the noise and demosaicing residue of its fewer photons (shot
+//!    noise in DoLP goes as `1/√S0`), while a dark glossy object polarizes far more than
+//!    that (Umov's effect; the bundled real frame's black camera body). The
 //!    occluding-contour signature below is no test of a face: a floor tile whose edges
 //!    run along and across the floor's AoLP shows it too. A weakly polarized object
 //!    that neither cue holds is lost.
@@ -309,10 +314,11 @@ struct Verdict {
 
 /// Per interior label of `id` (`n` labels; index 0 outside them): it is an object face
 /// when at least [`HELD_BY_B`] of the pixels within [`RING_FAR`] steps around it are B,
-/// when its median DoLP is above [`FACE_DOLP_FACTOR`] times the background's, taken as at
-/// least [`MIN_BACKGROUND_DOLP`] (then it is also `polarized`). The occluding-contour
-/// signature of its rim does not count: floor texture whose edges run along and across
-/// the floor's one AoLP shows it too.
+/// or when its median DoLP is above [`FACE_DOLP_FACTOR`] times the background's, taken as
+/// at least [`MIN_BACKGROUND_DOLP`] and multiplied by `√(background / interior)` of their
+/// median brightnesses where the interior is darker (then it is also `polarized`). The
+/// occluding-contour signature of its rim does not count: floor texture whose edges run
+/// along and across the floor's one AoLP shows it too.
 fn face_interiors(
     cues: &Cues,
     enclosed: &Enclosed,
@@ -329,25 +335,23 @@ fn face_interiors(
         c[0] += 1;
         c[1] += usize::from(coherent[k]);
     }
-    let background = median(
-        (0..w * h)
-            .filter(|&k| cues.valid[k] && !enclosed.regions[k] && !enclosed.interiors[k])
-            .map(|k| cues.dolp[k])
-            .collect(),
-    )
-    .map(|b| b.max(MIN_BACKGROUND_DOLP));
-    let mut dolp: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
-    for k in (0..w * h).filter(|&k| id[k] > 0 && cues.valid[k]) {
-        dolp[id[k] as usize].push(cues.dolp[k]);
-    }
+    let background: Vec<u32> = (0..w * h)
+        .map(|k| u32::from(!enclosed.regions[k] && !enclosed.interiors[k]))
+        .collect();
+    let [bg_dolp, bg_brightness] = median_dolp_and_brightness(cues, &background, 1)[1];
+    let bg_dolp = bg_dolp.map(|b| b.max(MIN_BACKGROUND_DOLP));
+    let interiors = median_dolp_and_brightness(cues, id, n);
     Ok((0..=n)
         .map(|c| {
             if c == 0 {
                 return Verdict::default();
             }
+            let [dolp, brightness] = interiors[c];
+            // The noise's DoLP grows as 1 / sqrt(brightness) (shot noise).
             let polarized = matches!(
-                (median(std::mem::take(&mut dolp[c])), background),
-                (Some(d), Some(b)) if d > FACE_DOLP_FACTOR * b
+                (dolp, bg_dolp, brightness, bg_brightness),
+                (Some(d), Some(b), Some(v), Some(bv))
+                    if d > FACE_DOLP_FACTOR * b * (bv / v.max(f32::MIN_POSITIVE)).sqrt().max(1.0)
             );
             let held = counts[c][1] as f64 >= HELD_BY_B * counts[c][0] as f64;
             Verdict {
@@ -356,6 +360,21 @@ fn face_interiors(
             }
         })
         .collect())
+}
+
+/// Per label of `id` (`n` labels; 0 unlabelled): the median DoLP and the median normalised
+/// brightness of its valid pixels.
+fn median_dolp_and_brightness(cues: &Cues, id: &[u32], n: usize) -> Vec<[Option<f32>; 2]> {
+    let mut values: Vec<[Vec<f32>; 2]> = vec![[Vec::new(), Vec::new()]; n + 1];
+    for k in (0..id.len()).filter(|&k| id[k] > 0 && cues.valid[k]) {
+        let v = &mut values[id[k] as usize];
+        v[0].push(cues.dolp[k]);
+        v[1].push(cues.s0n[k]);
+    }
+    values
+        .into_iter()
+        .map(|[d, b]| [median(d), median(b)])
+        .collect()
 }
 
 /// `fg` without the edge-free interiors that are holes of the rest of `fg` and look like
