@@ -25,9 +25,11 @@ const MATERIAL_CI_ACCURACY: f64 = 0.70;
 /// measured 0.841; below the bound sfp's object mask has lost about a whole object of the
 /// four small samples, which the accuracy alone would not show.
 const MATERIAL_CI_COVERAGE: f64 = 0.75;
-/// Transparent mask IoU on the ci glass family: measured 0.361 (target 0.85 clean); the
-/// bound fails if the depolarized-rim trim is lost (0.328 without).
-const TRANSPARENT_CI_IOU: f64 = 0.34;
+/// Transparent mask IoU on the ci glass family: measured 0.587 (target 0.85 clean; 0.577
+/// without the depolarized-rim trim, which `glass_mask_stays_on_the_glass` in
+/// polar-transparency's tests guards); the bound leaves room for float differences and
+/// fails on a regression of a tenth.
+const TRANSPARENT_CI_IOU: f64 = 0.5;
 
 use common::{arg, family_mean, json, standard_ci, vision};
 use polar_io::files::{self, vision};
