@@ -19,14 +19,14 @@
 //! 4. of the edge-free interiors only object faces count (`object_faces`): those B
 //!    holds (a tenth of the ring around them is B: a face inside its coherent rim),
 //!    and those polarized above the background (median DoLP twice the background's: a
-//!    glossy face whose AoLP varies too fast for B), the background's DoLP scaled to the
-//!    face's brightness as noise scales, by `√(background / face)` where the face is
-//!    darker; with the edges near them or near B. Edges also enclose cast shadows and
-//!    floor texture: they are no more polarized than the floor, and B touches a shadow
-//!    only along its contact line with the object. A deep shadow's DoLP does rise above
-//!    the lit floor's, by the noise and demosaicing residue of its fewer photons (shot
-//!    noise in DoLP goes as `1/√S0`), while a dark glossy object polarizes far more than
-//!    that (Umov's effect; the bundled real frame's black camera body). The
+//!    glossy face whose AoLP varies too fast for B), raised as noise grows on faces
+//!    darker than half the background, by `√(background / (2 face))`; with the edges
+//!    near them or near B. Edges also enclose cast shadows and floor texture: they are
+//!    no more polarized than the floor, and B touches a shadow only along its contact
+//!    line with the object. A deep shadow's DoLP does rise above the lit floor's, by the
+//!    noise and demosaicing residue of its fewer photons (shot noise in DoLP goes as
+//!    `1/√S0`), while a dark glossy object polarizes far more than that (Umov's effect;
+//!    the bundled real frame's black camera body). The
 //!    occluding-contour signature below is no test of a face: a floor tile whose edges
 //!    run along and across the floor's AoLP shows it too. A weakly polarized object
 //!    that neither cue holds is lost.
@@ -143,6 +143,12 @@ const POLARIZED_INTERIOR: f64 = 0.3;
 /// and demosaicing residue), above which an interior is a polarized object face: a glossy
 /// or dark dielectric whose AoLP varies too fast for cue B (the real camera's body).
 const FACE_DOLP_FACTOR: f32 = 2.0;
+/// Brightness, in units of the background's, down to which [`FACE_DOLP_FACTOR`] covers
+/// the growth of an interior's DoLP noise (`√2` at a half, against the factor's 2); darker
+/// interiors need a DoLP above the bar raised as their noise grows ([`noise_growth`]). At a
+/// quarter (no room to spare) noise-level faces of Mitsuba's metal spheres at 512² were
+/// lost with the shadows.
+const NOISE_COVERED: f32 = 0.5;
 /// Lowest background DoLP [`FACE_DOLP_FACTOR`] multiplies: a camera's DoLP noise floor
 /// (photon noise at mid-scale of an IMX250MZR-class sensor, about 5000 e⁻ per pixel,
 /// gives DoLP noise near 1/√5000 ≈ 0.014). Against a noise-free render's near-zero
@@ -315,10 +321,10 @@ struct Verdict {
 /// Per interior label of `id` (`n` labels; index 0 outside them): it is an object face
 /// when at least [`HELD_BY_B`] of the pixels within [`RING_FAR`] steps around it are B,
 /// or when its median DoLP is above [`FACE_DOLP_FACTOR`] times the background's, taken as
-/// at least [`MIN_BACKGROUND_DOLP`] and multiplied by `√(background / interior)` of their
-/// median brightnesses where the interior is darker (then it is also `polarized`). The
-/// occluding-contour signature of its rim does not count: floor texture whose edges run
-/// along and across the floor's one AoLP shows it too.
+/// at least [`MIN_BACKGROUND_DOLP`] and multiplied by [`noise_growth`] of their median
+/// brightnesses (then it is also `polarized`). The occluding-contour signature of its rim
+/// does not count: floor texture whose edges run along and across the floor's one AoLP
+/// shows it too.
 fn face_interiors(
     cues: &Cues,
     enclosed: &Enclosed,
@@ -347,11 +353,9 @@ fn face_interiors(
                 return Verdict::default();
             }
             let [dolp, brightness] = interiors[c];
-            // The noise's DoLP grows as 1 / sqrt(brightness) (shot noise).
             let polarized = matches!(
                 (dolp, bg_dolp, brightness, bg_brightness),
-                (Some(d), Some(b), Some(v), Some(bv))
-                    if d > FACE_DOLP_FACTOR * b * (bv / v.max(f32::MIN_POSITIVE)).sqrt().max(1.0)
+                (Some(d), Some(b), Some(v), Some(bv)) if d > FACE_DOLP_FACTOR * b * noise_growth(v, bv)
             );
             let held = counts[c][1] as f64 >= HELD_BY_B * counts[c][0] as f64;
             Verdict {
@@ -360,6 +364,16 @@ fn face_interiors(
             }
         })
         .collect())
+}
+
+/// How much more DoLP noise an interior of median brightness `v` has than the background
+/// of median brightness `bv`, as far as the face test's margin does not already cover it:
+/// shot noise's DoLP goes as `1/√S0`, and [`FACE_DOLP_FACTOR`]'s margin of 2 covers the
+/// background's noise to [`NOISE_COVERED`] of its brightness, with room to spare.
+fn noise_growth(v: f32, bv: f32) -> f32 {
+    (NOISE_COVERED * bv / v.max(f32::MIN_POSITIVE))
+        .sqrt()
+        .max(1.0)
 }
 
 /// Per label of `id` (`n` labels; 0 unlabelled): the median DoLP and the median normalised

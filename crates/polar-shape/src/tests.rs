@@ -843,9 +843,9 @@ fn attached_cast_shadow_is_not_foreground() {
 
 /// A deep cast shadow (0.15 of the floor's brightness) touching the sphere, whose DoLP noise
 /// is four times the floor's (fewer photons: up to 0.08 against 0.02): its median DoLP is
-/// above twice the background's but below that bar scaled to its brightness as noise
-/// scales (`√(1 / 0.15)`, 2.6 times), so it is no polarized face and stays out; the sphere
-/// is kept.
+/// above twice the background's but below that bar raised as the noise grows at its
+/// brightness (`√(0.5 / 0.15)`, 1.8 times), so it is no polarized face and stays out; the
+/// sphere is kept.
 #[test]
 fn deep_shadow_polarized_only_by_its_noise_is_not_foreground() {
     let (mut scene, sphere) = left_sphere();
