@@ -143,11 +143,11 @@ const POLARIZED_INTERIOR: f64 = 0.3;
 /// and demosaicing residue), above which an interior is a polarized object face: a glossy
 /// or dark dielectric whose AoLP varies too fast for cue B (the real camera's body).
 const FACE_DOLP_FACTOR: f32 = 2.0;
-/// Brightness, in units of the background's, down to which [`FACE_DOLP_FACTOR`] covers
-/// the growth of an interior's DoLP noise (`√2` at a half, against the factor's 2); darker
-/// interiors need a DoLP above the bar raised as their noise grows ([`noise_growth`]). At a
-/// quarter (no room to spare) noise-level faces of Mitsuba's metal spheres at 512² were
-/// lost with the shadows.
+/// Brightness, in units of the background's, below which the face bar is raised as an
+/// interior's DoLP noise grows ([`noise_growth`]). Above it the bar's factor 2 leaves the
+/// noise a margin of at least `√2`, and below it the raised bar keeps that margin; keeping
+/// the whole factor 2 everywhere also drops faces polarized barely above their noise
+/// (metal spheres under sensor noise), which the rule's material labels need.
 const NOISE_COVERED: f32 = 0.5;
 /// Lowest background DoLP [`FACE_DOLP_FACTOR`] multiplies: a camera's DoLP noise floor
 /// (photon noise at mid-scale of an IMX250MZR-class sensor, about 5000 e⁻ per pixel,
@@ -366,10 +366,10 @@ fn face_interiors(
         .collect())
 }
 
-/// How much more DoLP noise an interior of median brightness `v` has than the background
-/// of median brightness `bv`, as far as the face test's margin does not already cover it:
-/// shot noise's DoLP goes as `1/√S0`, and [`FACE_DOLP_FACTOR`]'s margin of 2 covers the
-/// background's noise to [`NOISE_COVERED`] of its brightness, with room to spare.
+/// The factor by which the face bar grows on an interior of median brightness `v` against
+/// a background of median brightness `bv`: shot noise's DoLP goes as `1/√S0`, so
+/// `√(NOISE_COVERED · bv / v)` below [`NOISE_COVERED`] of the background's brightness, 1
+/// above it.
 fn noise_growth(v: f32, bv: f32) -> f32 {
     (NOISE_COVERED * bv / v.max(f32::MIN_POSITIVE))
         .sqrt()
