@@ -72,9 +72,10 @@
 //! are given back to the background, twice (`trim_boundary`): the edges of A straddle
 //! the silhouette.
 //!
-//! Invalid pixels are never foreground. If neither cue finds anything (a surface filling
-//! the view, a tiny image), every valid pixel is foreground: the frame shows one surface
-//! and no occluding contour. A fails on an object that is neither coherently polarized
+//! Invalid pixels (saturated highlights) are foreground only where it mostly surrounds
+//! them (`with_enclosed_invalid`): a hole there would be a silhouette to the shape prior.
+//! If neither cue finds anything (a surface filling the view, a tiny image), every valid
+//! pixel is foreground: the frame shows one surface and no occluding contour. A fails on an object that is neither coherently polarized
 //! nor shows a contour signature (a bright diffuse object on a bright floor: it is
 //! dropped with the shadows); B fails on objects whose polarization is too weak or
 //! broken up to form a coherent field at the window's scale.
@@ -169,6 +170,10 @@ const DOLP_QUANTILE: f64 = 0.75;
 /// ([`polar_imgproc::mask::ArcJoin::rim_arcs`]): the arcs of one rim, broken where the
 /// diffuse and specular phases cancel.
 const ARC_NEAR: usize = 2;
+/// Share of the pixels around a region of invalid pixels that must be foreground for the
+/// region to join it ([`with_enclosed_invalid`]): a highlight inside an object is
+/// surrounded by it, a light source or sky beside the objects mostly by background.
+const INVALID_ENCLOSURE: f64 = 0.5;
 /// Passes of [`trim_boundary`] (each peels at most one pixel).
 const TRIM_PASSES: usize = 2;
 /// Half-width (pixels) of the window [`trim_boundary`] compares a boundary pixel in.
@@ -206,11 +211,51 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     let fg = with_evidence(fg, &evidence, w, h)?;
     let fg = fill_hull_gaps(cues, fg)?;
     let fg = (0..TRIM_PASSES).try_fold(fg, |fg, _| trim_boundary(cues, &fg))?;
+    let fg = with_enclosed_invalid(cues, fg)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
         Ok(cues.valid.clone())
     }
+}
+
+/// `fg` with the regions of invalid pixels (saturated highlights) of which at least
+/// [`INVALID_ENCLOSURE`] of the 4-neighbours around them are `fg`: a highlight on an
+/// object is part of it, and a hole there would be an occluding contour to the shape
+/// prior (`crate::local`), its normals turned away from the highlight. Their
+/// polarization is not measured: the methods give them their neighbours' shape.
+fn with_enclosed_invalid(cues: &Cues, mut fg: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
+    let invalid: Vec<bool> = cues.valid.iter().map(|&v| !v).collect();
+    let (id, n) = components(&invalid, w, h)?;
+    if n == 0 {
+        return Ok(fg);
+    }
+    // Per region: 4-neighbours outside it, and those of them in `fg`.
+    let mut around = vec![[0usize; 2]; n + 1];
+    for k in (0..w * h).filter(|&k| id[k] == 0) {
+        let (x, y) = (k % w, k / w);
+        let mut seen = [0u32; 4];
+        let near = [
+            (x > 0).then(|| k - 1),
+            (x + 1 < w).then(|| k + 1),
+            (y > 0).then(|| k - w),
+            (y + 1 < h).then(|| k + w),
+        ];
+        for (slot, j) in near.into_iter().flatten().enumerate() {
+            let c = id[j];
+            if c != 0 && !seen.contains(&c) {
+                seen[slot] = c;
+                around[c as usize][0] += 1;
+                around[c as usize][1] += usize::from(fg[k]);
+            }
+        }
+    }
+    for k in (0..w * h).filter(|&k| id[k] != 0) {
+        let [all, object] = around[id[k] as usize];
+        fg[k] = all > 0 && object as f64 >= INVALID_ENCLOSURE * all as f64;
+    }
+    Ok(fg)
 }
 
 /// Cue A of the module doc (at least 3×3 pixels).

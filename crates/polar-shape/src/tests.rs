@@ -1481,3 +1481,52 @@ fn rim_follows_curved_outlines_not_straight_edges() {
         .count();
     assert_eq!(mid_edge, 0, "rim pixels along the square's straight edges");
 }
+
+/// A saturated highlight inside a sphere (its pixels flagged, as the front end flags the
+/// demosaicing support of clipped samples) stays part of the object and of its shape:
+/// left out as a hole, its edge would be an occluding contour to the prior, and the
+/// normals around it would turn away from it.
+#[test]
+fn saturated_highlight_inside_an_object_is_no_silhouette() {
+    let scene = sphere_scene(96, 1.5);
+    let (w, h) = (scene.width, scene.height);
+    // Where the highlight of the light would sit, between the centre and the light.
+    let (cx, cy, r) = (56.0, 36.0, 5.0);
+    let in_highlight = |k: usize| {
+        let (x, y) = ((k % w) as f64, (k / w) as f64);
+        (x - cx).hypot(y - cy) <= r
+    };
+    let flags = (0..w * h)
+        .map(|k| {
+            if in_highlight(k) {
+                polar_sensor::mask::SATURATED
+            } else {
+                0
+            }
+        })
+        .collect();
+    let obs = scene
+        .observation(1.0)
+        .with_flags(polar_image::Gray::from_vec(w, h, flags).unwrap());
+    let shape = estimate_shape(&obs, &opts(Method::Local, Some(1.5))).unwrap();
+    let fg = shape.foreground.as_slice();
+    let flagged: Vec<usize> = (0..w * h).filter(|&k| in_highlight(k)).collect();
+    let inside = flagged.iter().filter(|&&k| fg[k] != 0).count();
+    assert_eq!(inside, flagged.len(), "highlight pixels in the foreground");
+    // The ring around the highlight: its normals nearly as good as the sphere's elsewhere
+    // (the end-to-end test's median is under 1 degree; next to the unmeasured pixels the
+    // field blends in theirs, about 2.5 degrees; left out as a hole, about 45).
+    let err = angles(&shape, &scene);
+    let ring: Vec<f64> = (0..w * h)
+        .filter(|&k| {
+            let (x, y) = ((k % w) as f64, (k / w) as f64);
+            (r + 1.0..=r + 4.0).contains(&(x - cx).hypot(y - cy))
+        })
+        .map(|k| err[k])
+        .collect();
+    let ring_median = median(ring);
+    assert!(
+        ring_median < 5.0,
+        "median error around the highlight {ring_median}"
+    );
+}
