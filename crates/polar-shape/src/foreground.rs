@@ -75,10 +75,11 @@
 //! Invalid pixels (saturated highlights) are foreground only where it mostly surrounds
 //! them (`with_enclosed_invalid`): a hole there would be a silhouette to the shape prior.
 //! If neither cue finds anything (a surface filling the view, a tiny image), every valid
-//! pixel is foreground: the frame shows one surface and no occluding contour. A fails on an object that is neither coherently polarized
-//! nor shows a contour signature (a bright diffuse object on a bright floor: it is
-//! dropped with the shadows); B fails on objects whose polarization is too weak or
-//! broken up to form a coherent field at the window's scale.
+//! pixel is foreground: the frame shows one surface and no occluding contour. A fails on
+//! an object that is neither coherently polarized nor shows a contour signature (a bright
+//! diffuse object on a bright floor: it is dropped with the shadows); B fails on objects
+//! whose polarization is too weak or broken up to form a coherent field at the window's
+//! scale.
 
 use std::collections::VecDeque;
 use std::ops::RangeInclusive;
@@ -219,11 +220,12 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     }
 }
 
-/// `fg` with the regions of invalid pixels (saturated highlights) of which at least
-/// [`INVALID_ENCLOSURE`] of the 4-neighbours around them are `fg`: a highlight on an
-/// object is part of it, and a hole there would be an occluding contour to the shape
-/// prior (`crate::local`), its normals turned away from the highlight. Their
-/// polarization is not measured: the methods give them their neighbours' shape.
+/// `fg` with the regions of invalid pixels (saturated highlights) inside the frame of
+/// which at least [`INVALID_ENCLOSURE`] of the 4-neighbours around them are `fg`: a
+/// highlight on an object is part of it, and a hole there would be an occluding contour to
+/// the shape prior (`crate::local`), its normals turned away from the highlight. Their
+/// polarization is not measured: the methods give them their neighbours' shape. A region
+/// reaching the frame's border (a saturated sky, a dark frame's unlit pixels) stays out.
 fn with_enclosed_invalid(cues: &Cues, mut fg: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let invalid: Vec<bool> = cues.valid.iter().map(|&v| !v).collect();
@@ -251,9 +253,11 @@ fn with_enclosed_invalid(cues: &Cues, mut fg: Vec<bool>) -> Result<Vec<bool>, Sh
             }
         }
     }
+    let at_border = touching_border(&id, n, w, h);
     for k in (0..w * h).filter(|&k| id[k] != 0) {
-        let [all, object] = around[id[k] as usize];
-        fg[k] = all > 0 && object as f64 >= INVALID_ENCLOSURE * all as f64;
+        let c = id[k] as usize;
+        let [all, object] = around[c];
+        fg[k] = !at_border[c] && all > 0 && object as f64 >= INVALID_ENCLOSURE * all as f64;
     }
     Ok(fg)
 }
