@@ -233,25 +233,12 @@ fn with_enclosed_invalid(cues: &Cues, mut fg: Vec<bool>) -> Result<Vec<bool>, Sh
     if n == 0 {
         return Ok(fg);
     }
-    // Per region: 4-neighbours outside it, and those of them in `fg`.
+    // Per region: the pixels one step outside it, and those of them in `fg`.
+    let (owner, dist) = grow_labels(&id, w, h, 1, |_| true);
     let mut around = vec![[0usize; 2]; n + 1];
-    for k in (0..w * h).filter(|&k| id[k] == 0) {
-        let (x, y) = (k % w, k / w);
-        let mut seen = [0u32; 4];
-        let near = [
-            (x > 0).then(|| k - 1),
-            (x + 1 < w).then(|| k + 1),
-            (y > 0).then(|| k - w),
-            (y + 1 < h).then(|| k + w),
-        ];
-        for (slot, j) in near.into_iter().flatten().enumerate() {
-            let c = id[j];
-            if c != 0 && !seen.contains(&c) {
-                seen[slot] = c;
-                around[c as usize][0] += 1;
-                around[c as usize][1] += usize::from(fg[k]);
-            }
-        }
+    for k in (0..w * h).filter(|&k| dist[k] == 1) {
+        around[owner[k] as usize][0] += 1;
+        around[owner[k] as usize][1] += usize::from(fg[k]);
     }
     let at_border = touching_border(&id, n, w, h);
     for k in (0..w * h).filter(|&k| id[k] != 0) {
