@@ -212,7 +212,7 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     let fg = with_evidence(fg, &evidence, w, h)?;
     let fg = fill_hull_gaps(cues, fg)?;
     let fg = (0..TRIM_PASSES).try_fold(fg, |fg, _| trim_boundary(cues, &fg))?;
-    let fg = with_enclosed_invalid(cues, fg)?;
+    let fg = with_enclosed_invalid(&cues.valid, w, h, fg)?;
     if fg.iter().any(|&v| v) {
         Ok(fg)
     } else {
@@ -226,9 +226,14 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
 /// the shape prior (`crate::local`), its normals turned away from the highlight. Their
 /// polarization is not measured: the methods give them their neighbours' shape. A region
 /// reaching the frame's border (a saturated sky, a dark frame's unlit pixels) stays out.
-fn with_enclosed_invalid(cues: &Cues, mut fg: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
-    let (w, h) = (cues.width, cues.height);
-    let invalid: Vec<bool> = cues.valid.iter().map(|&v| !v).collect();
+/// `valid` and `fg` are `w × h` masks.
+pub(crate) fn with_enclosed_invalid(
+    valid: &[bool],
+    w: usize,
+    h: usize,
+    mut fg: Vec<bool>,
+) -> Result<Vec<bool>, ShapeError> {
+    let invalid: Vec<bool> = valid.iter().map(|&v| !v).collect();
     let (id, n) = components(&invalid, w, h)?;
     if n == 0 {
         return Ok(fg);

@@ -299,7 +299,7 @@ pub fn estimate_shape(obs: &Observation, opts: &ShapeOptions) -> Result<Shape, S
         1 => estimate_at_scale(obs, opts, given),
         f => {
             let coarse = estimate_at_scale(&obs.binned(f), opts, given)?;
-            Ok(scale::Grid { w, h, f }.upsample(coarse, obs))
+            scale::Grid { w, h, f }.upsample(coarse, obs)
         }
     }
 }

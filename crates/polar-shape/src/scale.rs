@@ -17,8 +17,9 @@ use polar_image::{Gray, Image};
 use polar_sensor::Observation;
 use rayon::prelude::*;
 
-use crate::Shape;
 use crate::cues::usable;
+use crate::foreground::with_enclosed_invalid;
+use crate::{Shape, ShapeError};
 
 /// Default long side (pixels) of the image the steps work in.
 pub const WORKING_SIZE: usize = 256;
@@ -51,14 +52,20 @@ impl Grid {
 
     /// The shape of the fine observation `obs` from `coarse`, the shape of `obs` binned:
     /// the foreground, reflection types and confidence of each pixel's block, normals and
-    /// depth interpolated bilinearly between block centres (depth in fine
-    /// pixels), nothing on pixels that are not [`usable`].
-    pub fn upsample(&self, coarse: Shape, obs: &Observation) -> Shape {
+    /// depth interpolated bilinearly between block centres (depth in fine pixels). The
+    /// fine pixels that are not [`usable`] are foreground where the fine foreground
+    /// encloses them, as at the working scale (`foreground::with_enclosed_invalid`), with
+    /// normals and depth but neither a reflection type nor a confidence.
+    pub fn upsample(&self, coarse: Shape, obs: &Observation) -> Result<Shape, ShapeError> {
         let (w, h) = (self.w, self.h);
+        let valid: Vec<bool> = (0..w * h).into_par_iter().map(|k| usable(obs, k)).collect();
         let fg: Vec<bool> = (0..w * h)
             .into_par_iter()
-            .map(|k| coarse.foreground.as_slice()[self.block(k)] != 0 && usable(obs, k))
+            .map(|k| coarse.foreground.as_slice()[self.block(k)] != 0 && valid[k])
             .collect();
+        let fg = with_enclosed_invalid(&valid, w, h, fg)?;
+        // As at the working scale, an unmeasured pixel has no confidence and no type.
+        let measured: Vec<bool> = (0..w * h).map(|k| fg[k] && valid[k]).collect();
         let cn = coarse.normal.pixels();
         let normals: Vec<f32> = (0..w * h)
             .into_par_iter()
@@ -81,15 +88,15 @@ impl Grid {
                     .map_or(f32::NAN, |d| (d * self.f as f64) as f32)
             })
             .collect();
-        Shape {
+        Ok(Shape {
             normal: Image::from_vec(w, h, normals).expect("sized"),
             depth: Gray::from_vec(w, h, depth).expect("sized"),
-            confidence: self.nearest(&coarse.confidence, &fg),
-            reflection: self.nearest(&coarse.reflection, &fg),
+            confidence: self.nearest(&coarse.confidence, &measured),
+            reflection: self.nearest(&coarse.reflection, &measured),
             foreground: Gray::from_vec(w, h, fg.iter().map(|&f| 255 * u8::from(f)).collect())
                 .expect("sized"),
             ..coarse
-        }
+        })
     }
 
     /// Each foreground pixel takes its block's value, the others `T::default()`.
