@@ -1489,7 +1489,11 @@ fn rim_follows_curved_outlines_not_straight_edges() {
 #[test]
 fn saturated_highlight_inside_an_object_is_no_silhouette() {
     let (missing, ring_median) = highlight_on_a_sphere(0, true);
-    assert_eq!(missing, 0, "highlight pixels without a normal");
+    assert_eq!(
+        missing,
+        [0, 0],
+        "highlight pixels without a normal / with a type"
+    );
     // The ring around the highlight: its normals nearly as good as the sphere's elsewhere
     // (the end-to-end test's median is under 1 degree; next to the unmeasured pixels the
     // field blends in theirs, about 2.5 degrees; left out as a hole, about 45).
@@ -1504,7 +1508,11 @@ fn saturated_highlight_inside_an_object_is_no_silhouette() {
 #[test]
 fn saturated_highlight_keeps_its_normals_at_a_binned_working_scale() {
     let (missing, ring_median) = highlight_on_a_sphere(48, true);
-    assert_eq!(missing, 0, "highlight pixels without a normal");
+    assert_eq!(
+        missing,
+        [0, 0],
+        "highlight pixels without a normal / with a type"
+    );
     // Binning costs the ring a few degrees of its own (about 5.6 unflagged); the flags
     // may add at most one (left out as a hole, the ring would turn away by tens).
     let (_, unflagged) = highlight_on_a_sphere(48, false);
@@ -1516,8 +1524,9 @@ fn saturated_highlight_keeps_its_normals_at_a_binned_working_scale() {
 
 /// The highlight of a 96-pixel sphere, `flagged` saturated or not, estimated at
 /// `working_size` (0: the camera's pixels): the highlight's pixels without a foreground
-/// normal, and the median angular error (degrees) in the ring 1-4 pixels around it.
-fn highlight_on_a_sphere(working_size: usize, flagged: bool) -> (usize, f64) {
+/// normal and those with a reflection type or a confidence (their polarization is not
+/// measured), and the median angular error (degrees) in the ring 1-4 pixels around it.
+fn highlight_on_a_sphere(working_size: usize, flagged: bool) -> ([usize; 2], f64) {
     let scene = sphere_scene(96, 1.5);
     let (w, h) = (scene.width, scene.height);
     // Where the highlight of the light would sit, between the centre and the light.
@@ -1538,13 +1547,20 @@ fn highlight_on_a_sphere(working_size: usize, flagged: bool) -> (usize, f64) {
     };
     let shape = estimate_shape(&obs, &options).unwrap();
     let (fg, normals) = (shape.foreground.as_slice(), shape.normal.pixels());
-    let missing = (0..w * h)
-        .filter(|&k| from_centre(k) <= r && (fg[k] == 0 || normals[k] == [0.0; 3]))
+    let highlight: Vec<usize> = (0..w * h).filter(|&k| from_centre(k) <= r).collect();
+    let without_normal = highlight
+        .iter()
+        .filter(|&&k| fg[k] == 0 || normals[k] == [0.0; 3])
+        .count();
+    let (kind, conf) = (shape.reflection.as_slice(), shape.confidence.as_slice());
+    let typed = highlight
+        .iter()
+        .filter(|&&k| kind[k] != ReflectionType::None as u8 || conf[k] != 0.0)
         .count();
     let err = angles(&shape, &scene);
     let ring = (0..w * h)
         .filter(|&k| (r + 1.0..=r + 4.0).contains(&from_centre(k)))
         .map(|k| err[k])
         .collect();
-    (missing, median(ring))
+    ([without_normal, typed], median(ring))
 }
