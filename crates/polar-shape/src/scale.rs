@@ -59,13 +59,13 @@ impl Grid {
     pub fn upsample(&self, coarse: Shape, obs: &Observation) -> Result<Shape, ShapeError> {
         let (w, h) = (self.w, self.h);
         let valid: Vec<bool> = (0..w * h).into_par_iter().map(|k| usable(obs, k)).collect();
-        let fg: Vec<bool> = (0..w * h)
+        // The foreground's measured pixels; as at the working scale, the unmeasured ones it
+        // encloses join it without a confidence or a type.
+        let measured: Vec<bool> = (0..w * h)
             .into_par_iter()
             .map(|k| coarse.foreground.as_slice()[self.block(k)] != 0 && valid[k])
             .collect();
-        let fg = with_enclosed_invalid(&valid, w, h, fg)?;
-        // As at the working scale, an unmeasured pixel has no confidence and no type.
-        let measured: Vec<bool> = (0..w * h).map(|k| fg[k] && valid[k]).collect();
+        let fg = with_enclosed_invalid(&valid, w, h, measured.clone())?;
         let cn = coarse.normal.pixels();
         let normals: Vec<f32> = (0..w * h)
             .into_par_iter()
