@@ -58,6 +58,9 @@ rm -rf "$tmp"
 step "front end vs polanalyser"
 "$py" tools/polanalyser_goldens.py --check
 
+step "Mitsuba task scenes: the sensor noise's statistics and stability"
+"$py" tools/mitsuba/task_scenes.py --check-noise
+
 step "Mitsuba 3: Stokes frame experiment"
 "$py" tools/mitsuba/polarizer_check.py --threads 2
 

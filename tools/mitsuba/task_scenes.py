@@ -17,7 +17,9 @@ then what `polar-vision eval` measures on them.
 
 What it makes, under --out (default /work/data/mitsuba-tasks), one folder per
 scene and noise level, named `mts-<kind>-<noise>-<k>` so that the eval's
-family (the folder name without its trailing -digits) is `mts-<kind>-<noise>`:
+family (the folder name without its trailing -digits) is `mts-<kind>-<noise>`;
+the noisy family holds --noise-draws draws of the sensor noise per scene, draw d
+of scene k numbered k + 10 d (`mts-shape-noisy-13` is draw 1 of scene 3):
 
   kind      scenes  content
   shape     4       pplastic / diffuse spheres, ellipsoids, a torus, a rounded
@@ -39,8 +41,12 @@ family (the folder name without its trailing -digits) is `mts-<kind>-<noise>`:
                     function (rayleigh_phase.py) in `volpath`, sun from the side
 
   noise: `clean` (noiseless 12-bit quantization) and `noisy` (Poisson shot
-  noise, full well FULL_WELL_E, Gaussian read noise READ_NOISE_E); both share
-  the same Stokes image and ground truth.
+  noise, full well FULL_WELL_E, Gaussian read noise READ_NOISE_E); all share
+  the same Stokes image and ground truth. One draw of four small noisy frames
+  moves a task's mean by several degrees or points, so the noisy figure is a
+  mean over draws; and each pixel's noise is the Poisson quantile of its own
+  uniform draw, so a render that differs in its last bits on another machine
+  keeps the same noise (`sensor_noise`; `--check-noise` tests both).
 
 Each sample directory holds
   stokes.exr         float32 S0..S3 from Mitsuba's `stokes` integrator: its
@@ -74,6 +80,7 @@ box-filtered pixel means.
 
     tools/.venv/bin/python tools/mitsuba/task_scenes.py [--out DIR] [--spp 1024]
         [--haze-spp 512] [--size 128] [--threads 2] [--only PREFIX,..] [--no-dehazed]
+        [--noise-draws 5] [--redraw-noise] [--check-noise]
 
 Defaults take about 9.5 minutes on 2 cores (each surface scene 16 to 47 s, each
 haze scene 2 to 2.5 minutes: volpath with free-flight shadow rays is slow
@@ -106,6 +113,9 @@ HAZE_MAX_DEPTH = 8
 UP = [0.0, 1.0, 0.0]
 # Mosaic: the polarizer angle (degrees) of pixel (row % 2, column % 2).
 MOSAIC = np.array([[90.0, 45.0], [135.0, 0.0]])
+# Noise draw d of scene k is sample `mts-<kind>-noisy-<k + SCENES_PER_DRAW d>`.
+SCENES_PER_DRAW = 10
+MAX_DRAWS = 100
 LABEL_BACKGROUND, LABEL_DIELECTRIC, LABEL_METAL, LABEL_TRANSPARENT = 0, 1, 2, 3
 
 
@@ -674,17 +684,56 @@ def mosaic(stokes):
 def raw_dn(stokes, noisy, seed):
     """12-bit DN: the 99th percentile of S0 -> P99_FRACTION of full scale;
     noisy adds Poisson shot noise (FULL_WELL_E electrons at full scale) and
-    Gaussian read noise READ_NOISE_E, then quantizes and clips."""
+    Gaussian read noise READ_NOISE_E (`sensor_noise`), then quantizes and clips."""
     s0 = stokes[..., 0]
     p99 = float(np.percentile(s0[np.isfinite(s0)], 99))
     k = P99_FRACTION * FULL_SCALE / max(p99, 1e-30)
     dn = np.clip(mosaic(stokes) * k, 0.0, None)
     gain = FULL_WELL_E / FULL_SCALE  # electrons per DN
     if noisy:
-        rng = np.random.default_rng(seed)
-        electrons = rng.poisson(np.minimum(dn * gain, 1e9)) + rng.normal(0.0, READ_NOISE_E, dn.shape)
-        dn = electrons / gain
+        dn = sensor_noise(np.minimum(dn * gain, 1e9), seed) / gain
     return np.clip(np.rint(dn), 0, FULL_SCALE).astype(np.uint16), k, gain
+
+
+def sensor_noise(electrons, seed):
+    """Poisson shot noise and Gaussian read noise on mean electron counts. Every pixel
+    takes one uniform and one normal draw from the seeded stream whatever its mean,
+    and its shot noise is the Poisson quantile of its uniform (inverse transform), so a
+    render that differs in its last bits (another machine, another Mitsuba build)
+    keeps the same noise instead of drawing new noise, as a sampler whose use of the
+    stream depends on the means would."""
+    from scipy.stats import poisson
+
+    rng = np.random.default_rng(seed)
+    u = np.clip(rng.random(electrons.shape), 1e-12, 1.0 - 1e-12)
+    read = rng.normal(0.0, READ_NOISE_E, electrons.shape)
+    return poisson.ppf(u, electrons) + read
+
+
+def check_noise():
+    """The noise's two promises, checked without Mitsuba: its statistics (mean and
+    variance of the electrons at several means) and its stability (means changed by
+    one part in 10^6 keep the noise of nearly every pixel)."""
+    seed = 7
+    for mean in (0.5, 20.0, 3000.0):
+        e = sensor_noise(np.full((256, 256), mean), seed)
+        var = mean + READ_NOISE_E**2
+        # 65,536 samples: the sample mean's standard error is sqrt(var / n), the
+        # variance's about var * sqrt(2 / n) (0.6 %); 5 standard errors each.
+        se_mean, se_var = np.sqrt(var / e.size), var * np.sqrt(2.0 / e.size)
+        assert abs(e.mean() - mean) < 5 * se_mean, (mean, e.mean())
+        assert abs(e.var() - var) < 5 * se_var, (mean, e.var())
+    rng = np.random.default_rng(1)
+    means = rng.uniform(0.0, FULL_WELL_E, (256, 256))
+    changed = means * (1.0 + 1e-6)
+    a, b = sensor_noise(means, seed), sensor_noise(changed, seed)
+    # A pixel's quantile moves, by one electron, when its uniform lies within the CDF's
+    # change of a step: with probability about the change of its mean in electrons
+    # (0.005 on average here; a fresh draw would move nearly every pixel).
+    moved, expected = np.mean(a != b), np.mean(changed - means)
+    assert moved < 2 * expected and np.abs(a - b).max() <= 1, (moved, expected)
+    print(f"sensor noise: statistics within 5 standard errors; means changed by 1e-6 move "
+          f"{moved:.4f} of the pixels by one electron (expected about {expected:.4f})")
 
 
 # --------------------------------------------------------------------------- writing
@@ -717,39 +766,83 @@ def write_png(path, array):
     Image.fromarray(array).save(path)
 
 
-def write_sample(mi, out, name, stokes, gt, extra, meta):
-    """Writes the shared files of one scene into both noise levels' sample folders."""
-    for noise in ("clean", "noisy"):
-        kind, k = name.rsplit("-", 1)
-        d = out / f"{kind}-{noise}-{k}"
+def write_sample(mi, out, name, stokes, gt, extra, meta, draws):
+    """Writes one scene's clean sample folder and its `draws` noisy ones."""
+    kind, k = name.rsplit("-", 1)
+    d = out / f"{kind}-clean-{k}"
+    if d.exists():
+        shutil.rmtree(d)
+    (d / "gt").mkdir(parents=True)
+    write_exr(mi, d / "stokes.exr", stokes, ["S0", "S1", "S2", "S3"])
+    imgs = polarizer_images(stokes)
+    write_exr(mi, d / "polarizers.exr", np.stack([imgs[a] for a in (0, 45, 90, 135)], -1),
+              ["I0", "I45", "I90", "I135"])
+    write_exr(mi, d / "gt" / "normal.exr", gt["normal"], ["R", "G", "B"])
+    write_exr(mi, d / "gt" / "depth.exr", gt["depth"], ["Y"])
+    write_png(d / "gt" / "material.png", gt["material"])
+    write_png(d / "gt" / "transparent.png", gt["transparent"])
+    for key, img in extra.items():
+        write_exr(mi, d / "gt" / f"{key}.exr", img, ["Y"])
+    write_raw(d, stokes, meta, None)
+    write_noisy_draws(out, d, stokes, meta, draws)
+
+
+def noisy_name(clean, draw):
+    """The folder of noise draw `draw` of a clean sample folder `mts-<kind>-clean-<k>`:
+    `mts-<kind>-noisy-<k + 10 draw>`, one family for all draws."""
+    kind, k = clean.name.rsplit("-", 1)
+    return f"{kind.removesuffix('-clean')}-noisy-{int(k) + SCENES_PER_DRAW * draw}"
+
+
+def write_noisy_draws(out, clean, stokes, meta, draws):
+    """Copies the clean sample folder to each noise draw's and writes its raw and meta;
+    draws left from an earlier run with more of them are removed."""
+    for draw in range(draws, MAX_DRAWS):
+        stale = out / noisy_name(clean, draw)
+        if stale.exists():
+            shutil.rmtree(stale)
+    for draw in range(draws):
+        d = out / noisy_name(clean, draw)
         if d.exists():
             shutil.rmtree(d)
-        (d / "gt").mkdir(parents=True)
-        write_exr(mi, d / "stokes.exr", stokes, ["S0", "S1", "S2", "S3"])
-        imgs = polarizer_images(stokes)
-        write_exr(mi, d / "polarizers.exr", np.stack([imgs[a] for a in (0, 45, 90, 135)], -1),
-                  ["I0", "I45", "I90", "I135"])
-        seed = meta["seed"] * 2 + (noise == "noisy")
-        raw, k_dn, gain = raw_dn(stokes, noise == "noisy", seed)
-        write_png(d / "raw.png", raw)
-        write_exr(mi, d / "gt" / "normal.exr", gt["normal"], ["R", "G", "B"])
-        write_exr(mi, d / "gt" / "depth.exr", gt["depth"], ["Y"])
-        write_png(d / "gt" / "material.png", gt["material"])
-        write_png(d / "gt" / "transparent.png", gt["transparent"])
-        for key, img in extra.items():
-            write_exr(mi, d / "gt" / f"{key}.exr", img, ["Y"])
-        m = dict(meta)
-        m["sample"] = d.name
-        m["sensor"] = {
-            "noise": noise, "bits": BITS, "container_bits": 16, "alignment": "right",
-            "mosaic": {"row0": [90, 45], "row1": [135, 0]},
-            "dn_per_radiance": k_dn, "p99_s0_dn": P99_FRACTION * FULL_SCALE,
-            "full_well_e": FULL_WELL_E, "gain_e_per_dn": gain,
-            "read_noise_e": READ_NOISE_E if noise == "noisy" else 0.0,
-            "shot_noise": noise == "noisy",
-            "saturated_pixels": int(np.sum(raw >= FULL_SCALE)), "seed": seed,
-        }
-        (d / "meta.json").write_text(json.dumps(m, indent=2) + "\n")
+        shutil.copytree(clean, d)
+        write_raw(d, stokes, meta, draw)
+
+
+def write_raw(d, stokes, meta, draw):
+    """raw.png and meta.json of sample folder `d`: noiseless for `draw` None, else that
+    noise draw (its own seed)."""
+    noisy = draw is not None
+    seed = meta["seed"] * 2 + noisy + 1000 * (draw or 0)
+    raw, k_dn, gain = raw_dn(stokes, noisy, seed)
+    write_png(d / "raw.png", raw)
+    m = dict(meta)
+    m["sample"] = d.name
+    m["sensor"] = {
+        "noise": "noisy" if noisy else "clean", "noise_draw": draw,
+        "bits": BITS, "container_bits": 16, "alignment": "right",
+        "mosaic": {"row0": [90, 45], "row1": [135, 0]},
+        "dn_per_radiance": k_dn, "p99_s0_dn": P99_FRACTION * FULL_SCALE,
+        "full_well_e": FULL_WELL_E, "gain_e_per_dn": gain,
+        "read_noise_e": READ_NOISE_E if noisy else 0.0,
+        "shot_noise": noisy,
+        "saturated_pixels": int(np.sum(raw >= FULL_SCALE)), "seed": seed,
+    }
+    (d / "meta.json").write_text(json.dumps(m, indent=2) + "\n")
+
+
+def redraw_noise(mi, out, only, draws):
+    """Writes the noisy draws again from the clean sample folders under `out` (their
+    stokes.exr and meta.json), without rendering."""
+    cleans = sorted(p for p in out.glob("mts-*-clean-*") if p.is_dir())
+    cleans = [p for p in cleans if not only or any(p.name.startswith(o) for o in only)]
+    for clean in cleans:
+        stokes = np.array(mi.Bitmap(str(clean / "stokes.exr")), dtype=np.float64)
+        meta = json.loads((clean / "meta.json").read_text())
+        meta.pop("sample", None)
+        meta.pop("sensor", None)
+        write_noisy_draws(out, clean, stokes, meta, draws)
+        print(f"{clean.name}: {draws} noise draws", flush=True)
 
 
 def jsonable(desc):
@@ -808,7 +901,7 @@ def render_one(mi, dr, out, name, desc, args, seed):
         "scene": {"name": name, **jsonable(desc)},
         "ground_truth": {"rays": "pixel centres", "dehazed": "camera segment without medium" if "dehazed" in extra else None},
     }
-    write_sample(mi, out, name, stokes, gt, extra, meta)
+    write_sample(mi, out, name, stokes, gt, extra, meta, args.noise_draws)
     return seconds, stokes, gt
 
 
@@ -823,18 +916,34 @@ def main():
     ap.add_argument("--threads", type=int, default=None, help="Dr.Jit threads (default: all cores)")
     ap.add_argument("--only", default="", help="comma-separated scene-name prefixes, e.g. mts-haze,mts-shape-1")
     ap.add_argument("--no-dehazed", action="store_true", help="skip gt/dehazed.exr (saves ~1/3 of a haze scene's time)")
+    ap.add_argument("--noise-draws", type=int, default=5,
+                    help="noisy samples per scene, each with its own sensor-noise draw (one family)")
+    ap.add_argument("--redraw-noise", action="store_true",
+                    help="only write the noisy draws again from the clean samples under --out (no rendering)")
+    ap.add_argument("--check-noise", action="store_true",
+                    help="check the sensor noise's statistics and stability and exit (no Mitsuba)")
     args = ap.parse_args()
+    if args.check_noise:
+        check_noise()
+        return
     if min(args.spp, args.haze_spp) < 1 or args.size < 2 or args.size % 2:
         ap.error("--spp and --haze-spp must be >= 1 and --size even and >= 2")
+    if not 1 <= args.noise_draws <= MAX_DRAWS:
+        ap.error(f"--noise-draws must be in 1..{MAX_DRAWS}")
     mi, dr = common.setup_mitsuba(args.threads)
     args.out.mkdir(parents=True, exist_ok=True)
     only = [p for p in args.only.split(",") if p]
+    if args.redraw_noise:
+        redraw_noise(mi, args.out, only, args.noise_draws)
+        return
     t_all = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         meshes = Meshes(tmp)
         seed = 0
         for kind, make in KINDS.items():
-            for k, desc in enumerate(make(mi, meshes)):
+            descs = make(mi, meshes)
+            assert len(descs) <= SCENES_PER_DRAW, f"{kind}: noisy sample numbers would collide"
+            for k, desc in enumerate(descs):
                 name = f"mts-{kind}-{k}"
                 seed += 1
                 if only and not any(name.startswith(p) for p in only):
