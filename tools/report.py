@@ -4,6 +4,10 @@
 For each task it runs `polar-vision eval` on the task's families once per option set and
 reads the evaluation's metrics.json (the mean of the task's headline error over the
 family's samples, and the task's mean seconds per megapixel, as the CLI measures them).
+Beside each mean it gives the standard error of the mean over the samples (sample
+standard deviation / sqrt(n)): how far a family's mean would move with other samples of the
+same kind. Samples that share a scene (task_scenes.py's noise draws) are not independent,
+so on such families it understates how far the mean would move with other scenes.
 It writes one PNG plot per task (error against time) under docs/img/ and the tables into
 docs/benchmarks.md between the markers `<!-- report:begin -->` and `<!-- report:end -->`.
 Run on demand, not in CI:
@@ -70,8 +74,27 @@ def families_of(dataset: Path) -> list:
     return sorted(names)
 
 
+def sample_value(record: dict, task: str, key: str):
+    """The metric `key` (dotted path) of `task` in one sample's record of metrics.json, or
+    None where the sample failed or lacks it."""
+    value = (((record.get("Ok") or {}).get("tasks") or {}).get(task) or {}).get("metrics")
+    for part in key.split("."):
+        value = value.get(part) if isinstance(value, dict) else None
+    return value if isinstance(value, (int, float)) else None
+
+
+def standard_error(values: list):
+    """Standard error of the mean (sample standard deviation / sqrt(n)); None below 2."""
+    n = len(values)
+    if n < 2:
+        return None
+    mean = sum(values) / n
+    return (sum((v - mean) ** 2 for v in values) / (n - 1) / n) ** 0.5
+
+
 def evaluate(dataset: Path, task: str, key: str, families: list, options: list) -> dict:
-    """Runs eval; returns {family: (mean of the metric `key`, seconds per MP, samples)}."""
+    """Runs eval; returns {family: (mean of the metric `key`, its standard error over the
+    samples, seconds per MP, samples)}."""
     tasks = options[options.index("--tasks") + 1] if "--tasks" in options else task
     rest = [o for i, o in enumerate(options) if o != "--tasks" and (i == 0 or options[i - 1] != "--tasks")]
     with tempfile.TemporaryDirectory() as out:
@@ -79,11 +102,19 @@ def evaluate(dataset: Path, task: str, key: str, families: list, options: list) 
                "--family", ",".join(families), *rest]
         subprocess.run(cmd, check=False, capture_output=True)
         metrics = json.loads((Path(out) / "metrics.json").read_text())
+    per_family = {}
+    for sample, record in metrics["samples"].items():
+        value = sample_value(record, task, key)
+        if value is not None:
+            per_family.setdefault(sample.rsplit("-", 1)[0], []).append(value)
     result = {}
     for fam, per_task in metrics["families"].items():
         agg = per_task.get(task)
         if agg:
-            result[fam] = (agg["means"].get(key), agg["seconds_per_mp"], agg["samples"])
+            values, mean = per_family.get(fam, []), agg["means"].get(key)
+            if mean is not None and values and abs(sum(values) / len(values) - mean) > 1e-6 * max(1.0, abs(mean)):
+                sys.exit(f"{fam}: the samples' {key} do not average to the family's mean {mean}")
+            result[fam] = (mean, standard_error(values), agg["seconds_per_mp"], agg["samples"])
     return result
 
 
@@ -99,7 +130,8 @@ def main():
     lines = []
     for (picture, task), (prefixes, key, label, lower, options) in TASKS.items():
         lines += [f"### {task}: {label} against time", "",
-                  "| data | family | option | " + label + " | s / MP | samples |", "|---|---|---|---|---|---|"]
+                  "| data | family | option | " + label + " | standard error | s / MP | samples |",
+                  "|---|---|---|---|---|---|---|"]
         fig, ax = plt.subplots(figsize=(6, 4))
         for name, path in sets:
             path = Path(path)
@@ -108,10 +140,11 @@ def main():
                 continue
             for opt_name, opts in options.items():
                 res = evaluate(path, task, key, fams, opts)
-                for fam, (value, spm, n) in sorted(res.items()):
+                for fam, (value, se, spm, n) in sorted(res.items()):
                     v = "-" if value is None else f"{value:.3f}"
+                    e = "-" if se is None else f"{se:.3f}"
                     s = "-" if spm is None else f"{spm:.3f}"
-                    lines.append(f"| {name} | {fam} | {opt_name} | {v} | {s} | {n} |")
+                    lines.append(f"| {name} | {fam} | {opt_name} | {v} | {e} | {s} | {n} |")
                     if value is not None and spm is not None:
                         ax.scatter(spm, value, label=f"{name} {fam}: {opt_name}")
         ax.set_xscale("log")
