@@ -22,6 +22,7 @@ evaluated with the same options and reported beside it: the generalization gap.
 
 import argparse
 import json
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -85,11 +86,7 @@ def sample_value(record: dict, task: str, key: str):
 
 def standard_error(values: list):
     """Standard error of the mean (sample standard deviation / sqrt(n)); None below 2."""
-    n = len(values)
-    if n < 2:
-        return None
-    mean = sum(values) / n
-    return (sum((v - mean) ** 2 for v in values) / (n - 1) / n) ** 0.5
+    return statistics.stdev(values) / len(values) ** 0.5 if len(values) >= 2 else None
 
 
 def evaluate(dataset: Path, task: str, key: str, families: list, options: list) -> dict:

@@ -797,16 +797,13 @@ def noisy_name(clean, draw):
 def write_noisy_draws(out, clean, stokes, meta, draws):
     """Copies the clean sample folder to each noise draw's and writes its raw and meta;
     draws left from an earlier run with more of them are removed."""
-    for draw in range(draws, MAX_DRAWS):
-        stale = out / noisy_name(clean, draw)
-        if stale.exists():
-            shutil.rmtree(stale)
-    for draw in range(draws):
+    for draw in range(MAX_DRAWS):
         d = out / noisy_name(clean, draw)
         if d.exists():
             shutil.rmtree(d)
-        shutil.copytree(clean, d)
-        write_raw(d, stokes, meta, draw)
+        if draw < draws:
+            shutil.copytree(clean, d)
+            write_raw(d, stokes, meta, draw)
 
 
 def write_raw(d, stokes, meta, draw):
@@ -836,6 +833,9 @@ def redraw_noise(mi, out, only, draws):
     stokes.exr and meta.json), without rendering."""
     cleans = sorted(p for p in out.glob("mts-*-clean-*") if p.is_dir())
     cleans = [p for p in cleans if not only or any(p.name.startswith(o) for o in only)]
+    if not cleans:
+        sys.exit(f"--redraw-noise: no clean sample folders (mts-*-clean-*) under {out}"
+                 + (f" matching --only {','.join(only)}" if only else ""))
     for clean in cleans:
         stokes = np.array(mi.Bitmap(str(clean / "stokes.exr")), dtype=np.float64)
         meta = json.loads((clean / "meta.json").read_text())

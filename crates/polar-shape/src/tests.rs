@@ -1533,9 +1533,12 @@ fn highlight_on_a_sphere(working_size: usize, flagged: bool) -> ([usize; 2], f64
     let (cx, cy, r) = (56.0, 36.0, 5.0);
     let from_centre = |k: usize| ((k % w) as f64 - cx).hypot((k / w) as f64 - cy);
     let flags = (0..w * h)
-        .map(|k| match from_centre(k) <= r {
-            true if flagged => polar_sensor::mask::SATURATED,
-            _ => 0,
+        .map(|k| {
+            if flagged && from_centre(k) <= r {
+                polar_sensor::mask::SATURATED
+            } else {
+                0
+            }
         })
         .collect();
     let obs = scene
