@@ -64,10 +64,12 @@
 //! not held to the contour signature: on glossy objects the diffuse and specular parts
 //! cancel along stretches of the rim, and the shape prior checks it per boundary pixel
 //! instead (`crate::local`). Last, the gaps between a component and its convex hull that
-//! the component mostly borders and that are as bright as it are filled
-//! (`fill_hull_gaps`; two large blobs joined by a narrow neck are hulled apart): a white
-//! object on a light floor is found as the open arcs of its rim, its face toward the
-//! camera too weakly polarized and edged for either cue. Then
+//! the component mostly borders and that are as bright as it, or whose stretch of the
+//! hull's outline shows the occluding-contour signature, are filled (`fill_hull_gaps`;
+//! two large blobs joined by a narrow neck are hulled apart): a white object on a light
+//! floor is found as the open arcs of its rim, its face toward the camera too weakly
+//! polarized and edged for either cue, and its shaded side may be as dark as the floor,
+//! but the rim between the arcs still polarizes as a rim does. Then
 //! the boundary pixels as bright as the background beside them rather than the object
 //! are given back to the background, twice (`trim_boundary`): the edges of A straddle
 //! the silhouette.
@@ -519,7 +521,12 @@ fn with_evidence(
 /// `fg` with the gaps between each component and its convex hull that the component
 /// borders on at least [`HULL_ENCLOSURE`] of the pixels next to them and that do not look
 /// like the background ([`looks_through`]): an object's face between the coherent arcs of
-/// its rim, as bright as the rim, rather than the floor seen between two objects.
+/// its rim, as bright as the rim, rather than the floor seen between two objects. A gap
+/// that looks like the background is filled all the same where the hull's outline along
+/// it shows the occluding-contour signature ([`has_contour`]): the shaded side of a white
+/// ball, as dark as the floor, bounded by its rim; a hole seen through an object lies
+/// inside the hull, off its outline, and the floor between two objects meets the outline
+/// along chords over the floor.
 pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let hull = hull_per_blob(&fg, w, h)?;
@@ -531,6 +538,7 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
         return Ok(fg);
     }
     let outside = brightness_around(cues, &hull);
+    let rims = contour_sums(cues, &hull, &id, n)?;
     let (owner, dist) = grow_labels(&id, w, h, RING_FAR, |_| true);
     let mut gap: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
     let mut object: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
@@ -551,11 +559,12 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
         .map(|c| {
             c > 0
                 && near[c][1] as f64 >= HULL_ENCLOSURE * near[c][0] as f64
-                && !looks_through(
-                    median(std::mem::take(&mut gap[c])),
-                    median(std::mem::take(&mut object[c])),
-                    outside,
-                )
+                && (has_contour(rims[c][0], rims[c][1], rims[c][2])
+                    || !looks_through(
+                        median(std::mem::take(&mut gap[c])),
+                        median(std::mem::take(&mut object[c])),
+                        outside,
+                    ))
         })
         .collect();
     Ok((0..w * h).map(|k| fg[k] || fill[id[k] as usize]).collect())
@@ -938,9 +947,9 @@ fn touching_border(id: &[u32], n: usize, w: usize, h: usize) -> Vec<bool> {
     at_border
 }
 
-/// Per label of `id` (`n` labels over the pixels of `m`), the sums [`has_contour`] tests
-/// over the label's boundary pixels: `Σ ρ cos 4Δ`, `Σ ρ`, `Σ ρ²`, with `Δ` the AoLP
-/// against the outward normal of `m`'s smoothed boundary.
+/// Per label of `id` (`n` labels on pixels of `m`, 0 unlabelled), the sums [`has_contour`]
+/// tests over the label's pixels on `m`'s boundary: `Σ ρ cos 4Δ`, `Σ ρ`, `Σ ρ²`, with `Δ`
+/// the AoLP against the outward normal of `m`'s smoothed boundary.
 fn contour_sums(
     cues: &Cues,
     m: &[bool],

@@ -1275,6 +1275,58 @@ fn face_between_rim_arcs_is_filled_floor_is_not() {
     }
 }
 
+/// A diffuse ball lit so that only its rim is brighter than the floor (its face as dark as
+/// the floor, as on the shaded side of a white ball), found as its rim's ring with a short
+/// break: the face looks like the floor seen through, but the hull's outline across the
+/// break runs along the rim, which polarizes there as an occluding contour does, so the
+/// face is filled. With the break's polarization taken away it stays out.
+#[test]
+fn face_as_dark_as_the_floor_inside_a_polarized_rim_is_filled() {
+    let n = 64;
+    let centre = Vector3::new(0.0, 0.0, -5.0);
+    // Bright where the view meets the surface beyond 55 degrees: the rim's ring.
+    let rim_cos = 55f64.to_radians().cos();
+    let scene = Scene::render(n, n, 30.0, 1.5, 0.2, |d| {
+        sphere_hit(d, centre, 1.0).map(|m| {
+            let s0 = if -m.dot(&d.normalize()) < rim_cos {
+                0.8
+            } else {
+                0.2
+            };
+            (m, Kind::Diffuse, s0)
+        })
+    });
+    let in_break = |k: usize| {
+        let (dx, dy) = ((k % n) as f64 + 0.5 - 32.0, (k / n) as f64 + 0.5 - 32.0);
+        dy.atan2(dx).abs() < 0.26
+    };
+    let fg: Vec<bool> = (0..n * n)
+        .map(|k| scene.stokes[k][0] > 0.5 && !in_break(k))
+        .collect();
+    let disc = |k: usize| scene.normals[k].norm_squared() > 0.0;
+    assert!(fg.iter().filter(|&&v| v).count() > 300, "the ring is there");
+    for polarized_break in [true, false] {
+        let mut obs = scene.observation(1.0);
+        if !polarized_break {
+            for k in (0..n * n).filter(|&k| in_break(k)) {
+                obs.planes.s1.as_mut_slice()[k] = 0.0;
+                obs.planes.s2.as_mut_slice()[k] = 0.0;
+            }
+        }
+        let cues = Cues::new(&obs, 1.5).unwrap();
+        let out = crate::foreground::fill_hull_gaps(&cues, fg.clone()).unwrap();
+        assert_eq!(
+            out[32 * n + 32],
+            polarized_break,
+            "polarized break {polarized_break}"
+        );
+        assert!(
+            (0..n * n).all(|k| !out[k] || disc(k)),
+            "nothing off the ball"
+        );
+    }
+}
+
 /// Two boxes whose regions a thin bar joins along their bottoms (a shared shadow, a strip
 /// of floor) enclose the floor between them on three sides, nearer their brightness than
 /// the floor around: it is no face of either, so it stays out (one hull over both fills
