@@ -66,11 +66,12 @@
 //! instead (`crate::local`). Last, the gaps between a component and its convex hull that
 //! the component mostly borders and that are as bright as it, or whose stretch of the
 //! hull's outline shows the occluding-contour signature, are filled (`fill_hull_gaps`;
-//! two large blobs joined by a narrow neck are hulled apart): a white object on a light
-//! floor is found as the open arcs of its rim, its face toward the camera too weakly
-//! polarized and edged for either cue, and its shaded side may be as dark as the floor,
-//! but the rim between the arcs still polarizes as a rim does. Then
-//! the boundary pixels as bright as the background beside them rather than the object
+//! two large blobs joined by a narrow neck are hulled apart, the arcs of one rim share a
+//! hull where it runs along them or shows the signature across their breaks,
+//! `hull_per_blob`): a white object on a light floor is found as the open arcs of its
+//! rim, its face toward the camera too weakly polarized and edged for either cue, and its
+//! shaded side may be as dark as the floor, but the rim between the arcs still polarizes
+//! as a rim does. Then the boundary pixels as bright as the background beside them rather than the object
 //! are given back to the background, twice (`trim_boundary`): the edges of A straddle
 //! the silhouette.
 //!
@@ -173,6 +174,15 @@ const DOLP_QUANTILE: f64 = 0.75;
 /// ([`polar_imgproc::mask::ArcJoin::rim_arcs`]): the arcs of one rim, broken where the
 /// diffuse and specular phases cancel.
 const ARC_NEAR: usize = 2;
+/// The outline coverage down to which [`hull_per_blob`] also joins blobs whose joint
+/// hull's outline, away from them, shows the occluding-contour signature: the signature
+/// decides, not this bar (0.5-0.7 gave the same foreground on the shape sets measured,
+/// docs/benchmarks.md).
+const SIGNED_ARC_COVERAGE: f32 = 0.6;
+/// Steps from the blobs beyond which [`hull_per_blob`] reads the joint hull's outline: the
+/// outline's pixels next to the blobs are the blobs' own rims, which carry the signature
+/// even where the outline crosses the floor between two objects.
+const OUTLINE_AWAY: u32 = 2;
 /// Share of the pixels around a region of invalid pixels that must be foreground for the
 /// region to join it ([`with_enclosed_invalid`]): a highlight inside an object is
 /// surrounded by it, a light source or sky beside the objects mostly by background.
@@ -529,7 +539,7 @@ fn with_evidence(
 /// along chords over the floor.
 pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
-    let hull = hull_per_blob(&fg, w, h)?;
+    let hull = hull_per_blob(cues, &fg)?;
     let gaps: Vec<bool> = (0..w * h)
         .map(|k| hull[k] && !fg[k] && cues.valid[k])
         .collect();
@@ -572,13 +582,42 @@ pub(crate) fn fill_hull_gaps(cues: &Cues, fg: Vec<bool>) -> Result<Vec<bool>, Sh
 
 /// The union of the convex hulls of `fg`'s blobs ([`polar_imgproc::mask::blobs_apart`]: the
 /// floor seen between two objects whose regions touch through a shared shadow is a gap of
-/// neither), blobs that are the arcs of one rim under one hull ([`ARC_NEAR`]).
-fn hull_per_blob(fg: &[bool], w: usize, h: usize) -> Result<Vec<bool>, ShapeError> {
+/// neither), blobs that are the arcs of one rim under one hull ([`ARC_NEAR`]). Where a
+/// join down to [`SIGNED_ARC_COVERAGE`] hulls more blobs together, its hull is taken when
+/// its outline more than [`OUTLINE_AWAY`] steps from them shows the occluding-contour
+/// signature ([`has_contour`]): the rim runs on between the arcs, broken only in the mask;
+/// between two objects the outline crosses the floor.
+pub(crate) fn hull_per_blob(cues: &Cues, fg: &[bool]) -> Result<Vec<bool>, ShapeError> {
+    let (w, h) = (cues.width, cues.height);
     let apart = polar_imgproc::mask::blobs_apart(fg, w, h)?;
     let join = polar_imgproc::mask::ArcJoin::rim_arcs(w, h, ARC_NEAR);
-    Ok(polar_imgproc::mask::convex_hulls_joined(
-        &apart, w, h, &join,
-    )?)
+    let mut hull = polar_imgproc::mask::convex_hulls_joined(&apart, w, h, &join)?;
+    let signed = polar_imgproc::mask::ArcJoin {
+        min_coverage: SIGNED_ARC_COVERAGE,
+        ..join
+    };
+    let wider = polar_imgproc::mask::convex_hulls_joined(&apart, w, h, &signed)?;
+    let (id, n) = components(&wider, w, h)?;
+    let mut joins_more = vec![false; n + 1];
+    for k in (0..w * h).filter(|&k| wider[k] && !hull[k]) {
+        joins_more[id[k] as usize] = true;
+    }
+    if !joins_more.contains(&true) {
+        return Ok(hull);
+    }
+    let blobs: Vec<u32> = fg.iter().map(|&v| u32::from(v)).collect();
+    let (_, dist) = grow_labels(&blobs, w, h, OUTLINE_AWAY, |_| true);
+    let away: Vec<u32> = (0..w * h)
+        .map(|k| if dist[k] == u32::MAX { id[k] } else { 0 })
+        .collect();
+    let sums = contour_sums(cues, &wider, &away, n)?;
+    let take: Vec<bool> = (0..=n)
+        .map(|c| joins_more[c] && has_contour(sums[c][0], sums[c][1], sums[c][2]))
+        .collect();
+    for (k, v) in hull.iter_mut().enumerate() {
+        *v |= take[id[k] as usize];
+    }
+    Ok(hull)
 }
 
 /// `fg` without the boundary pixels (those with a 4-neighbour outside `fg`) whose log

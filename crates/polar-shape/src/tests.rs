@@ -1327,6 +1327,67 @@ fn face_as_dark_as_the_floor_inside_a_polarized_rim_is_filled() {
     }
 }
 
+/// The same ball, smaller in a larger frame, found as two arcs of its rim with breaks too
+/// long for the arcs' joint hull to pass on its outline's coverage alone: across the breaks
+/// the rim still polarizes as an occluding contour, so the arcs take one hull. With the
+/// breaks' polarization taken away they keep one hull each.
+#[test]
+fn rim_arcs_whose_breaks_polarize_as_a_rim_share_one_hull() {
+    let n = 128;
+    let centre = Vector3::new(0.0, 0.0, -5.0);
+    let rim_cos = 55f64.to_radians().cos();
+    let scene = Scene::render(n, n, 30.0, 1.5, 0.2, |d| {
+        sphere_hit(d, centre, 0.334).map(|m| {
+            let s0 = if -m.dot(&d.normalize()) < rim_cos {
+                0.8
+            } else {
+                0.2
+            };
+            (m, Kind::Diffuse, s0)
+        })
+    });
+    // Breaks of 15 pixels along the rim (radius about 16), left and right.
+    let in_break = |k: usize| ((k / n) as f64 + 0.5 - 64.0).abs() < 7.5;
+    let fg: Vec<bool> = (0..n * n)
+        .map(|k| scene.stokes[k][0] > 0.5 && !in_break(k))
+        .collect();
+    assert_eq!(
+        polar_imgproc::mask::components(&fg, n, n).unwrap().1,
+        2,
+        "two arcs"
+    );
+    for polarized_breaks in [true, false] {
+        let mut obs = scene.observation(1.0);
+        if !polarized_breaks {
+            for k in (0..n * n).filter(|&k| in_break(k)) {
+                obs.planes.s1.as_mut_slice()[k] = 0.0;
+                obs.planes.s2.as_mut_slice()[k] = 0.0;
+            }
+        }
+        let cues = Cues::new(&obs, 1.5).unwrap();
+        let hull = crate::foreground::hull_per_blob(&cues, &fg).unwrap();
+        assert_eq!(
+            hull[64 * n + 64],
+            polarized_breaks,
+            "polarized breaks {polarized_breaks}"
+        );
+        // The hull runs through pixels' edge midpoints: at most a pixel past the ball.
+        let near_ball = |k: usize| {
+            let (x, y) = ((k % n) as isize, (k / n) as isize);
+            (-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    let j = ((y + dy) * n as isize + x + dx) as usize;
+                    scene.normals[j].norm_squared() > 0.0
+                })
+            })
+        };
+        assert!(
+            (0..n * n).all(|k| !hull[k] || near_ball(k)),
+            "nothing off the ball"
+        );
+    }
+}
+
 /// Two boxes whose regions a thin bar joins along their bottoms (a shared shadow, a strip
 /// of floor) enclose the floor between them on three sides, nearer their brightness than
 /// the floor around: it is no face of either, so it stays out (one hull over both fills
