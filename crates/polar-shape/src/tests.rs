@@ -1275,19 +1275,15 @@ fn face_between_rim_arcs_is_filled_floor_is_not() {
     }
 }
 
-/// A diffuse ball lit so that only its rim is brighter than the floor (its face as dark as
-/// the floor, as on the shaded side of a white ball), found as its rim's ring with a short
-/// break: the face looks like the floor seen through, but the hull's outline across the
-/// break runs along the rim, which polarizes there as an occluding contour does, so the
-/// face is filled. With the break's polarization taken away it stays out.
-#[test]
-fn face_as_dark_as_the_floor_inside_a_polarized_rim_is_filled() {
-    let n = 64;
+/// A diffuse ball of `radius` 5 units in front of the pinhole camera (30° field of view,
+/// `n` × `n` pixels), lit so that only its rim (where the view meets the surface beyond
+/// 55°) is brighter than the floor: its face is as dark as the floor, as on the shaded side
+/// of a white ball.
+fn rim_lit_ball(n: usize, radius: f64) -> Scene {
     let centre = Vector3::new(0.0, 0.0, -5.0);
-    // Bright where the view meets the surface beyond 55 degrees: the rim's ring.
     let rim_cos = 55f64.to_radians().cos();
-    let scene = Scene::render(n, n, 30.0, 1.5, 0.2, |d| {
-        sphere_hit(d, centre, 1.0).map(|m| {
+    Scene::render(n, n, 30.0, 1.5, 0.2, |d| {
+        sphere_hit(d, centre, radius).map(|m| {
             let s0 = if -m.dot(&d.normalize()) < rim_cos {
                 0.8
             } else {
@@ -1295,97 +1291,88 @@ fn face_as_dark_as_the_floor_inside_a_polarized_rim_is_filled() {
             };
             (m, Kind::Diffuse, s0)
         })
-    });
-    let in_break = |k: usize| {
-        let (dx, dy) = ((k % n) as f64 + 0.5 - 32.0, (k / n) as f64 + 0.5 - 32.0);
-        dy.atan2(dx).abs() < 0.26
-    };
+    })
+}
+
+/// The cues of `scene` with the polarization of the pixels where `off` holds taken away.
+fn cues_unpolarized_where(scene: &Scene, off: impl Fn(usize) -> bool) -> Cues {
+    let mut obs = scene.observation(1.0);
+    for k in (0..scene.width * scene.height).filter(|&k| off(k)) {
+        obs.planes.s1.as_mut_slice()[k] = 0.0;
+        obs.planes.s2.as_mut_slice()[k] = 0.0;
+    }
+    Cues::new(&obs, 1.5).unwrap()
+}
+
+/// Checks a foreground step `grow` (given the cues and the found rim) on `scene`, a
+/// [`rim_lit_ball`] found as its bright rim less the pixels where `in_break` holds: the
+/// step covers the frame's centre exactly when the breaks keep their polarization, and
+/// adds nothing more than a pixel past the ball (a hull runs through pixels' edge
+/// midpoints).
+fn assert_polarized_breaks_decide(
+    scene: &Scene,
+    in_break: impl Fn(usize) -> bool,
+    grow: impl Fn(&Cues, Vec<bool>) -> Vec<bool>,
+) {
+    let n = scene.width;
     let fg: Vec<bool> = (0..n * n)
         .map(|k| scene.stokes[k][0] > 0.5 && !in_break(k))
         .collect();
-    let disc = |k: usize| scene.normals[k].norm_squared() > 0.0;
-    assert!(fg.iter().filter(|&&v| v).count() > 300, "the ring is there");
-    for polarized_break in [true, false] {
-        let mut obs = scene.observation(1.0);
-        if !polarized_break {
-            for k in (0..n * n).filter(|&k| in_break(k)) {
-                obs.planes.s1.as_mut_slice()[k] = 0.0;
-                obs.planes.s2.as_mut_slice()[k] = 0.0;
-            }
-        }
-        let cues = Cues::new(&obs, 1.5).unwrap();
-        let out = crate::foreground::fill_hull_gaps(&cues, fg.clone()).unwrap();
+    assert!(fg.iter().filter(|&&v| v).count() > 100, "the rim is there");
+    let near_ball = |k: usize| {
+        let (x, y) = ((k % n) as isize, (k / n) as isize);
+        (-1..=1).any(|dy| {
+            (-1..=1).any(|dx| {
+                let j = ((y + dy) * n as isize + x + dx) as usize;
+                scene.normals[j].norm_squared() > 0.0
+            })
+        })
+    };
+    for polarized in [true, false] {
+        let cues = cues_unpolarized_where(scene, |k| !polarized && in_break(k));
+        let out = grow(&cues, fg.clone());
         assert_eq!(
-            out[32 * n + 32],
-            polarized_break,
-            "polarized break {polarized_break}"
+            out[n / 2 * n + n / 2],
+            polarized,
+            "polarized breaks {polarized}"
         );
         assert!(
-            (0..n * n).all(|k| !out[k] || disc(k)),
+            (0..n * n).all(|k| !out[k] || near_ball(k)),
             "nothing off the ball"
         );
     }
 }
 
-/// The same ball, smaller in a larger frame, found as two arcs of its rim with breaks too
-/// long for the arcs' joint hull to pass on its outline's coverage alone: across the breaks
-/// the rim still polarizes as an occluding contour, so the arcs take one hull. With the
-/// breaks' polarization taken away they keep one hull each.
+/// [`rim_lit_ball`] found as its rim's ring with a short break: the face looks like the
+/// floor seen through, but the hull's outline across the break runs along the rim, which
+/// polarizes there as an occluding contour does, so the face is filled. With the break's
+/// polarization taken away it stays out.
+#[test]
+fn face_as_dark_as_the_floor_inside_a_polarized_rim_is_filled() {
+    let n = 64;
+    let in_break = |k: usize| {
+        let (dx, dy) = ((k % n) as f64 + 0.5 - 32.0, (k / n) as f64 + 0.5 - 32.0);
+        dy.atan2(dx).abs() < 0.26
+    };
+    assert_polarized_breaks_decide(&rim_lit_ball(n, 1.0), in_break, |cues, fg| {
+        crate::foreground::fill_hull_gaps(cues, fg).unwrap()
+    });
+}
+
+/// [`rim_lit_ball`], smaller in a larger frame, found as two arcs of its rim with breaks
+/// of 15 pixels (radius about 16), too long for the arcs' joint hull to pass on its
+/// outline's coverage alone: across the breaks the rim still polarizes as an occluding
+/// contour, so the arcs take one hull. With the breaks' polarization taken away they keep
+/// one hull each.
 #[test]
 fn rim_arcs_whose_breaks_polarize_as_a_rim_share_one_hull() {
     let n = 128;
-    let centre = Vector3::new(0.0, 0.0, -5.0);
-    let rim_cos = 55f64.to_radians().cos();
-    let scene = Scene::render(n, n, 30.0, 1.5, 0.2, |d| {
-        sphere_hit(d, centre, 0.334).map(|m| {
-            let s0 = if -m.dot(&d.normalize()) < rim_cos {
-                0.8
-            } else {
-                0.2
-            };
-            (m, Kind::Diffuse, s0)
-        })
-    });
-    // Breaks of 15 pixels along the rim (radius about 16), left and right.
     let in_break = |k: usize| ((k / n) as f64 + 0.5 - 64.0).abs() < 7.5;
-    let fg: Vec<bool> = (0..n * n)
-        .map(|k| scene.stokes[k][0] > 0.5 && !in_break(k))
-        .collect();
-    assert_eq!(
-        polar_imgproc::mask::components(&fg, n, n).unwrap().1,
-        2,
-        "two arcs"
-    );
-    for polarized_breaks in [true, false] {
-        let mut obs = scene.observation(1.0);
-        if !polarized_breaks {
-            for k in (0..n * n).filter(|&k| in_break(k)) {
-                obs.planes.s1.as_mut_slice()[k] = 0.0;
-                obs.planes.s2.as_mut_slice()[k] = 0.0;
-            }
-        }
-        let cues = Cues::new(&obs, 1.5).unwrap();
-        let hull = crate::foreground::hull_per_blob(&cues, &fg).unwrap();
-        assert_eq!(
-            hull[64 * n + 64],
-            polarized_breaks,
-            "polarized breaks {polarized_breaks}"
-        );
-        // The hull runs through pixels' edge midpoints: at most a pixel past the ball.
-        let near_ball = |k: usize| {
-            let (x, y) = ((k % n) as isize, (k / n) as isize);
-            (-1..=1).any(|dy| {
-                (-1..=1).any(|dx| {
-                    let j = ((y + dy) * n as isize + x + dx) as usize;
-                    scene.normals[j].norm_squared() > 0.0
-                })
-            })
-        };
-        assert!(
-            (0..n * n).all(|k| !hull[k] || near_ball(k)),
-            "nothing off the ball"
-        );
-    }
+    assert_polarized_breaks_decide(&rim_lit_ball(n, 0.334), in_break, |cues, fg| {
+        let arcs = polar_imgproc::mask::components(&fg, n, n).unwrap().1;
+        assert_eq!(arcs, 2, "two arcs");
+        crate::foreground::hull_per_blob(cues, &fg).unwrap()
+    });
 }
 
 /// Two boxes whose regions a thin bar joins along their bottoms (a shared shadow, a strip
