@@ -71,9 +71,9 @@
 //! `hull_per_blob`): a white object on a light floor is found as the open arcs of its
 //! rim, its face toward the camera too weakly polarized and edged for either cue, and its
 //! shaded side may be as dark as the floor, but the rim between the arcs still polarizes
-//! as a rim does. Then the boundary pixels as bright as the background beside them rather than the object
-//! are given back to the background, twice (`trim_boundary`): the edges of A straddle
-//! the silhouette.
+//! as a rim does. Then the boundary pixels as bright as the background beside them rather
+//! than the object are given back to the background, twice (`trim_boundary`): the edges
+//! of A straddle the silhouette.
 //!
 //! Invalid pixels (saturated highlights) are foreground only where it mostly surrounds
 //! them (`with_enclosed_invalid`): a hole there would be a silhouette to the shape prior.
@@ -176,8 +176,8 @@ const DOLP_QUANTILE: f64 = 0.75;
 const ARC_NEAR: usize = 2;
 /// The outline coverage down to which [`hull_per_blob`] also joins blobs whose joint
 /// hull's outline, away from them, shows the occluding-contour signature: the signature
-/// decides, not this bar (0.5-0.7 gave the same foreground on the shape sets measured,
-/// docs/benchmarks.md).
+/// decides, the bar only keeps such joins to blobs that outline most of their hull
+/// (docs/benchmarks.md, "a face as dark as the floor inside its rim").
 const SIGNED_ARC_COVERAGE: f32 = 0.6;
 /// Steps from the blobs beyond which [`hull_per_blob`] reads the joint hull's outline: the
 /// outline's pixels next to the blobs are the blobs' own rims, which carry the signature
