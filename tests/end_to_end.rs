@@ -360,9 +360,22 @@ fn dehazing_on_the_ci_haze_family() {
     assert!(dehazed > hazy, "dehazed {dehazed} dB, hazy {hazy} dB");
 }
 
+/// Material alone: it makes sfp's estimate for itself (its cues are those of sfp's
+/// normals), writes none of sfp's files, and labels every sample as with sfp in the run.
 #[test]
 fn material_classification_on_the_ci_material_family() {
-    let (dir, m) = eval("materials", "sfp,material", "2");
+    let (dir, m) = eval("materials", "material", "2");
+    let (with_sfp, _) = eval("materials", "sfp,material", "2");
+    for sample in std::fs::read_dir(dir.path().join("samples")).unwrap() {
+        let sample = sample.unwrap().file_name();
+        let path = |d: &std::path::Path, file| d.join("samples").join(&sample).join(file);
+        assert!(!path(dir.path(), vision::NORMAL).exists(), "{sample:?}");
+        assert!(
+            std::fs::read(path(dir.path(), vision::MATERIAL)).unwrap()
+                == std::fs::read(path(with_sfp.path(), vision::MATERIAL)).unwrap(),
+            "{sample:?}: material.png differs with sfp in the run"
+        );
+    }
     let acc = family_mean(&m, "materials", "material", "metal_vs_dielectric_accuracy");
     let coverage = family_mean(&m, "materials", "material", "opaque_coverage");
     eprintln!("materials ci: metal vs dielectric {acc:.3} over {coverage:.3} of the objects");

@@ -54,7 +54,6 @@ TASKS = {
     ("material", "material"): (["materials", "mts-material"], "metal_vs_dielectric_accuracy",
                                "metal vs dielectric accuracy", False, {
         "physics rule, with sfp normals": ["--tasks", "sfp,material"],
-        "physics rule, no normals": ["--tasks", "material"],
         "kNN, builtin model, with sfp normals": ["--tasks", "sfp,material", "--material-model", "builtin"],
     }),
     ("transparent", "transparent"): (["glass"], "iou", "mask IoU", False, {

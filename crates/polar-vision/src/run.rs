@@ -37,8 +37,9 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Tasks to run, comma-separated (default: all). They run in the order sfp,
-    /// transparent, material, dehaze; material uses sfp's normals and object mask and
-    /// the transparency mask.
+    /// transparent, material, dehaze; material uses sfp's normals and object mask (made
+    /// for it, not written, when sfp is not requested) and the transparency mask, which
+    /// relabels its objects transparent except those it calls metal.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = Task::ALL)]
     pub tasks: Vec<Task>,
     /// Which file of a sample directory to read: raw (the camera's mosaic; the default

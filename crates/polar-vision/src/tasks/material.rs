@@ -14,8 +14,25 @@ use crate::writes::Writes;
 
 /// Runs the task with the normals, object mask and transparency mask of earlier tasks,
 /// where they ran (one foreground for both tasks: sfp's follows the occluding contours).
+/// Without `sfp` in the run its estimate is made here and not written: the classifier's
+/// cues (and a kNN model's features) are those of sfp's normals.
 pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
     let clf = args.material_classifier()?;
+    let mut outcome = Outcome::default();
+    if ctx.normals.is_none() {
+        match super::sfp::estimate(ctx, args) {
+            Ok(shape) => {
+                ctx.normals = Some(shape.normal);
+                ctx.objects = Some(shape.foreground);
+                outcome
+                    .messages
+                    .push("normals and objects from sfp, made for this task and not written (add sfp to --tasks to keep them)".into());
+            }
+            Err(e) => outcome
+                .messages
+                .push(format!("sfp {e}: azimuths from the silhouettes instead")),
+        }
+    }
     let map = classify(
         ctx.obs,
         ctx.normals.as_ref(),
@@ -42,13 +59,8 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
         polar_io::write_rgb8_png(picture_path(out, pictures::MATERIAL), &picture)
     });
     files.run().map_err(io)?;
-    let mut outcome = Outcome::default();
     if let Classifier::Knn(m) = &clf {
         outcome.messages.push(knn_message(m.model()));
-    } else if ctx.normals.is_none() {
-        outcome
-            .messages
-            .push("without sfp's normals: azimuths from the silhouettes".into());
     }
     if let Some(gt) = &ctx.gt.material {
         let m = material_metrics(&map.labels, gt).map_err(|e| Failure::CannotRun(e.to_string()))?;

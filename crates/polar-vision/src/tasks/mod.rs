@@ -24,8 +24,8 @@ pub enum Task {
     Sfp,
     /// Transparent-object detection: transparent.png (polar-transparency).
     Transparent,
-    /// Material classification: material.png (polar-material; uses sfp's normals and the
-    /// transparency mask when those tasks ran).
+    /// Material classification: material.png (polar-material; uses sfp's normals, made for
+    /// it when sfp is not requested, and the transparency mask when that task ran).
     Material,
     /// Polarization dehazing: dehazed.exr, transmission.exr (polar-dehaze).
     Dehaze,

@@ -20,15 +20,25 @@ use crate::writes::Writes;
 /// Names of the reflection types, index = value of reflection.png.
 const REFLECTION_NAMES: [&str; 4] = ["none", "diffuse", "specular", "mixed"];
 
-/// Runs the task; leaves the normals for `material`.
-pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
-    let opts = ShapeOptions {
+/// The shape estimate of the options in `args`, without writing anything (also for
+/// `material` when this task was not requested).
+pub fn estimate(ctx: &Context<'_>, args: &TaskArgs) -> Result<Shape, Failure> {
+    estimate_shape(ctx.obs, &options(args)).map_err(|e| Failure::CannotRun(e.to_string()))
+}
+
+fn options(args: &TaskArgs) -> ShapeOptions {
+    ShapeOptions {
         method: args.sfp_method,
         integrator: args.integrator,
         ior: args.ior.unwrap_or_default(),
         working_size: args.sfp_working_size,
-    };
-    let shape = estimate_shape(ctx.obs, &opts).map_err(|e| Failure::CannotRun(e.to_string()))?;
+    }
+}
+
+/// Runs the task; leaves the normals for `material`.
+pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
+    let opts = options(args);
+    let shape = estimate(ctx, args)?;
     write(ctx, &shape)?;
     let mut outcome = Outcome::default();
     let objects = shape
