@@ -133,8 +133,10 @@ pub struct MaterialMap {
 /// only for the kind it is trained with; `polar-vision train` uses shape from
 /// polarization's). `foreground`: non-zero on object
 /// pixels; without it [`foreground::estimate`] decides. `transparent`: non-zero on
-/// transparent pixels, which are labelled [`TRANSPARENT`] over the opaque classification.
-/// They stay in the object regions it classifies: the edge of a transparency mask is no
+/// transparent pixels, which are labelled [`TRANSPARENT`] over the opaque classification
+/// except on objects it calls metal: glass is a dielectric, and the transparency cues also
+/// mark mirror-like metals, whose reflections polarize coherently. Transparent pixels stay
+/// in the object regions it classifies: the edge of a transparency mask is no
 /// occluding contour, and cutting an opaque object along a mistaken one would give its
 /// remaining pixels a false silhouette and a smaller region vote.
 pub fn classify(
@@ -155,7 +157,8 @@ pub fn classify(
     let (w, h) = obs.size();
     let clear = |m: Option<&Gray<u8>>, k: usize| m.is_some_and(|m| m.as_slice()[k] != 0);
     let label = |k: usize| {
-        if clear(transparent, k) {
+        let metal_object = p.fg[k] && metal[k] > 0.5;
+        if clear(transparent, k) && !metal_object {
             (TRANSPARENT, 1.0)
         } else if !p.fg[k] {
             (BACKGROUND, 1.0)

@@ -168,6 +168,20 @@ fn transparent_mask_wins() {
     assert_eq!(out.labels.as_slice()[0], BACKGROUND);
 }
 
+/// A transparency mask over both a glass-like dielectric sphere and a gold one relabels
+/// the dielectric only: glass is a dielectric, and the transparency cues also mark
+/// mirror-like metals, whose reflections polarize coherently.
+#[test]
+fn transparent_mask_leaves_a_metal_object_metal() {
+    let (obs, _, fg) = scene([Surface::Specular(1.5, 0.0), Surface::Specular(0.43, 2.455)]);
+    let t = Gray::from_vec(W, H, vec![255u8; W * H]).unwrap();
+    let opts = MaterialOptions::default();
+    let out = classify(&obs, None, Some(&fg), Some(&t), &Classifier::Physics, &opts).unwrap();
+    assert!(share(&out.labels, 0, TRANSPARENT) > 0.95);
+    assert!(share(&out.labels, 1, METAL) > 0.95);
+    assert_eq!(out.labels.as_slice()[0], TRANSPARENT);
+}
+
 /// A transparency mask that cuts into an opaque object (a false positive of the
 /// transparency task over the left half of the diffuse sphere) relabels those pixels and
 /// changes nothing else: its edge is no occluding contour, so the rest of the sphere keeps
