@@ -32,12 +32,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = ROOT / "target/release/polar-vision"
 DOC = ROOT / "docs/benchmarks.md"
 IMG = ROOT / "docs/img"
 
+MARKERS = ["o", "s", "^", "v", "D", "P", "X", "*", "<", ">", "h", "p", "d", "8"]
 DEHAZE_OPTIONS = {
     "polarization": ["--dehaze-method", "polarization"],
     "dark channel": ["--dehaze-method", "dark-channel"],
@@ -128,7 +130,10 @@ def main():
         lines += [f"### {task}: {label} against time", "",
                   "| data | family | option | " + label + " | standard error | s / MP | samples |",
                   "|---|---|---|---|---|---|---|"]
-        fig, ax = plt.subplots(figsize=(6, 4))
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        # Colour = option, marker = data set and family, so the legend lists each once.
+        colours = {opt: f"C{i}" for i, opt in enumerate(options)}
+        markers = {}
         for name, path in sets:
             path = Path(path)
             fams = [f for f in families_of(path) if any(f.startswith(p) or f"-{p}" in f for p in prefixes)]
@@ -142,11 +147,14 @@ def main():
                     s = "-" if spm is None else f"{spm:.3f}"
                     lines.append(f"| {name} | {fam} | {opt_name} | {v} | {e} | {s} | {n} |")
                     if value is not None and spm is not None:
-                        ax.scatter(spm, value, label=f"{name} {fam}: {opt_name}")
+                        marker = markers.setdefault(f"{name} {fam}", MARKERS[len(markers) % len(MARKERS)])
+                        ax.scatter(spm, value, color=colours[opt_name], marker=marker)
         ax.set_xscale("log")
         ax.set_xlabel("seconds per megapixel (2 cores)")
         ax.set_ylabel(label + (" (lower is better)" if lower else " (higher is better)"))
-        ax.legend(fontsize=6)
+        handles = [Line2D([], [], color=c, marker="o", linestyle="", label=o) for o, c in colours.items()]
+        handles += [Line2D([], [], color="0.4", marker=m, linestyle="", label=d) for d, m in markers.items()]
+        ax.legend(handles=handles, fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
         fig.tight_layout()
         fig.savefig(IMG / f"report-{picture}.png", dpi=110)
         plt.close(fig)

@@ -40,6 +40,20 @@ of scene k numbered k + 10 d (`mts-shape-noisy-13` is draw 1 of scene 3):
                     medium with the project's polarized Rayleigh phase
                     function (rayleigh_phase.py) in `volpath`, sun from the side
 
+  and a second set, written after the methods' last change and measured once
+  (held out: not for tuning), with shapes, lights and layouts the first lacks:
+  shape2    4       a vase with a concave neck, a boxier superquadric, a
+                    cylinder with sharp rims, a flattened and a lying ellipsoid,
+                    touching spheres; sky alone, a grazing sun, a lamp overhead,
+                    the sun behind the camera
+  material2 3       rough gold, smooth aluminium, a copper vase, a rough silver
+                    torus, a silver and a plastic cylinder of one shape, white
+                    and black glossy plastic, a matte cube
+  glass2    3       a glass cylinder, a glass superquadric and torus, a glass
+                    egg lying on the floor; a glossy white and a gold distractor
+  haze2     2       cylinders, a vase, boxy blocks; thin haze with the sun at
+                    right angles, dense haze with the sun behind the camera
+
   noise: `clean` (noiseless 12-bit quantization) and `noisy` (Poisson shot
   noise, full well FULL_WELL_E, Gaussian read noise READ_NOISE_E); all share
   the same Stokes image and ground truth. One draw of four small noisy frames
@@ -82,7 +96,7 @@ box-filtered pixel means.
         [--haze-spp 512] [--size 128] [--threads 2] [--only PREFIX,..] [--no-dehazed]
         [--noise-draws 5] [--redraw-noise] [--check-noise]
 
-Defaults take about 9.5 minutes on 2 cores (each surface scene 16 to 47 s, each
+Defaults take about 9.5 minutes on 2 cores for the first set (each surface scene 16 to 47 s, each
 haze scene 2 to 2.5 minutes: volpath with free-flight shadow rays is slow
 and noisy). Results of `polar-vision eval` on them: task_scenes.md.
 """
@@ -198,6 +212,45 @@ def cup_mesh(radius, wall, height, base):
     offsets = np.cumsum([0] + [len(p) for p, _, _ in parts[:-1]])
     return (np.vstack([p for p, _, _ in parts]), np.vstack([n for _, n, _ in parts]),
             np.vstack([f + o for (_, _, f), o in zip(parts, offsets)]))
+
+
+def solid_of_revolution(radius, slope, height, nv=64):
+    """A closed solid of revolution standing on y = 0: the side r = radius(y) for y in
+    [0, height] (outward normal (1, -slope(y)) in the (r, y) plane) and flat caps, each
+    its own strip (the caps' edges keep their normals)."""
+    y = np.linspace(height, 0.0, nv)
+    r, dr = radius(y), slope(y)
+    n = np.stack([np.ones_like(y), -dr], -1) / np.hypot(1.0, dr)[:, None]
+    strips = [
+        [(0.0, height, 0, 1), (r[0], height, 0, 1)],
+        [(ri, yi, nr, ny) for ri, yi, (nr, ny) in zip(r, y, n)],
+        [(r[-1], 0.0, 0, -1), (0.0, 0.0, 0, -1)],
+    ]
+    parts = [revolved(strip) for strip in strips]
+    offsets = np.cumsum([0] + [len(p) for p, _, _ in parts[:-1]])
+    return (np.vstack([p for p, _, _ in parts]), np.vstack([n for _, n, _ in parts]),
+            np.vstack([f + o for (_, _, f), o in zip(parts, offsets)]))
+
+
+def vase_mesh(height, base, bulge, neck):
+    """A vase: radius base + bulge sin(pi y / height) - neck sin^2(pi y / height)^4
+    toward the top, so that its side is convex low down and concave at the neck."""
+    k = np.pi / height
+
+    def radius(y):
+        u = k * y
+        return base + bulge * np.sin(u) - neck * np.sin(0.5 * u) ** 8
+
+    def slope(y):
+        u = k * y
+        return k * (bulge * np.cos(u) - neck * 4.0 * np.sin(0.5 * u) ** 7 * np.cos(0.5 * u))
+
+    return solid_of_revolution(radius, slope, height)
+
+
+def cylinder_mesh(radius, height):
+    """A closed cylinder standing on y = 0 (sharp edges at its caps)."""
+    return solid_of_revolution(lambda y: radius + 0 * y, lambda y: 0 * y, height, nv=2)
 
 
 def write_ply(path, positions, normals, faces):
@@ -521,8 +574,183 @@ def haze_scenes(mi, m):
     ]
 
 
+# The second set: scenes written after the methods' last change and measured once, with
+# shapes, lights and layouts the first set does not have (a vase with a concave neck,
+# cylinders with sharp rims, a boxier superquadric, flattened and lying ellipsoids; sky
+# alone, a grazing sun, light from behind the camera, two lamps). Not for tuning.
+def shape_scenes_2(mi, m):
+    return [
+        {  # a vase with a concave neck and a boxy superquadric under the sky alone
+            "camera": ([0.4, 2.8, 4.6], [0.0, 0.6, 0.0], 36.0),
+            "objects": {
+                "vase": (mesh(mi, m, "vase", lambda: vase_mesh(1.3, 0.3, 0.25, 0.18), pplastic(0.5, 0.08),
+                              [-0.7, 0.0, 0.0]), LABEL_DIELECTRIC),
+                "box": (mesh(mi, m, "rcube8", lambda: rounded_cube_mesh(0.4, power=8.0), pplastic(0.35, 0.12, 1.6),
+                             [0.85, 0.4, 0.3], rotate=[([0, 1, 0], 40)]), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi, bsdf={"type": "diffuse", "reflectance": 0.4})},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.9}},
+        },
+        {  # a flattened disc-like ellipsoid and a lying capsule, sun low from the right
+            "camera": ([-0.5, 1.7, 5.0], [0.0, 0.4, 0.0], 34.0),
+            "objects": {
+                "disc": (mesh(mi, m, "ell-disc", lambda: ellipsoid_mesh(0.7, 0.25, 0.7), pplastic(0.6, 0.1, 1.45),
+                              [-0.7, 0.45, 0.2], rotate=[([1, 0, 0], 35), ([0, 0, 1], 10)]), LABEL_DIELECTRIC),
+                "capsule": (mesh(mi, m, "ell-caps", lambda: ellipsoid_mesh(0.8, 0.28, 0.28), pplastic(0.25, 0.05),
+                                 [0.9, 0.28, -0.1], rotate=[([0, 1, 0], -30)]), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi, bsdf={"type": "diffuse", "reflectance": 0.15})},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.3}, "sun": sun([1.0, 0.25, 0.2], 4.0)},
+        },
+        {  # a cylinder with sharp rims and a sphere under one lamp overhead and a dim sky
+            "camera": ([0.0, 2.5, 4.9], [0.0, 0.5, 0.0], 36.0),
+            "objects": {
+                "drum": (mesh(mi, m, "cyl", lambda: cylinder_mesh(0.45, 0.7), pplastic(0.45, 0.1),
+                              [-0.6, 0.0, -0.1], rotate=[([0, 0, 1], 0)]), LABEL_DIELECTRIC),
+                "ball": (sphere([0.85, 0.5, 0.4], 0.5, pplastic(0.7, 0.25, 1.55)), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi, bsdf=checker_bsdf(mi, 0.3, 0.5, 6.0))},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.1},
+                         "lamp": sphere_light([0.0, 4.5, 0.5], 0.8, 18.0)},
+        },
+        {  # three touching spheres, rough and smooth, the sun behind the camera
+            "camera": ([0.2, 1.6, 5.2], [0.0, 0.55, 0.0], 32.0),
+            "objects": {
+                "big": (sphere([-0.4, 0.7, -0.3], 0.7, pplastic(0.4, 0.3)), LABEL_DIELECTRIC),
+                "small": (sphere([0.55, 0.4, 0.3], 0.4, pplastic(0.2, 0.02, 1.7)), LABEL_DIELECTRIC),
+                "matte": (sphere([-0.95, 0.35, 0.65], 0.35, {"type": "diffuse", "reflectance": 0.5}), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi)},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.35}, "sun": sun([0.1, 0.7, 1.0], 3.0)},
+        },
+    ]
+
+
+def material_scenes_2(mi, m):
+    return [
+        {  # rough gold, smooth aluminium, a white and a black glossy plastic
+            "camera": ([-0.3, 2.2, 5.3], [0.0, 0.5, 0.0], 40.0),
+            "objects": {
+                "gold": (mesh(mi, m, "ell-g", lambda: ellipsoid_mesh(0.5, 0.4, 0.6), metal("Au", 0.2),
+                              [-1.3, 0.4, 0.0], rotate=[([0, 1, 0], 25)]), LABEL_METAL),
+                "alu": (mesh(mi, m, "rcube", lambda: rounded_cube_mesh(0.55), metal("Al"),
+                             [-0.1, 0.45, -0.5], rotate=[([0, 1, 0], 15)], scale=0.8), LABEL_METAL),
+                "white": (sphere([1.0, 0.45, 0.1], 0.45, pplastic(0.8, 0.02)), LABEL_DIELECTRIC),
+                "black": (sphere([0.3, 0.3, 0.9], 0.3, pplastic(0.03, 0.1)), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi, bsdf={"type": "diffuse", "reflectance": 0.5})},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.6}, "sun": sun([-1.0, 0.7, 0.2], 2.5)},
+        },
+        {  # a copper vase, a rough silver torus and a matte cube, lamp and dim sky
+            "camera": ([0.6, 2.6, 4.8], [0.0, 0.5, 0.0], 38.0),
+            "objects": {
+                "vase": (mesh(mi, m, "vase", lambda: vase_mesh(1.3, 0.3, 0.25, 0.18), metal("Cu", 0.05),
+                              [-0.9, 0.0, -0.2]), LABEL_METAL),
+                "ring": (mesh(mi, m, "torus", lambda: torus_mesh(0.75, 0.3), metal("Ag", 0.1),
+                              [0.7, 0.3, 0.4], scale=0.7), LABEL_METAL),
+                "cube": (mesh(mi, m, "rcube8", lambda: rounded_cube_mesh(0.4, power=8.0),
+                              {"type": "diffuse", "reflectance": 0.3}, [0.5, 0.4, -0.8],
+                              rotate=[([0, 1, 0], 20)]), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi, bsdf=checker_bsdf(mi, 0.2, 0.4, 8.0))},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.2},
+                         "lamp": sphere_light([2.5, 3.5, 2.5], 0.6, 25.0)},
+        },
+        {  # a silver and a plastic cylinder alike in shape, a small gold ball, sun from the back
+            "camera": ([0.0, 2.0, 5.4], [0.0, 0.5, 0.0], 36.0),
+            "objects": {
+                "chrome": (mesh(mi, m, "cyl", lambda: cylinder_mesh(0.45, 0.7), metal("Ag"),
+                                [-0.8, 0.0, 0.0]), LABEL_METAL),
+                "plastic": (mesh(mi, m, "cyl", lambda: cylinder_mesh(0.45, 0.7), pplastic(0.3, 0.06),
+                                 [0.6, 0.0, -0.3]), LABEL_DIELECTRIC),
+                "bead": (sphere([0.0, 0.25, 0.9], 0.25, metal("Au")), LABEL_METAL),
+            },
+            "background": {"floor": floor(mi)},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.45}, "sun": sun([-0.5, 0.9, -0.8], 3.0)},
+        },
+    ]
+
+
+def glass_scenes_2(mi, m):
+    board = checker_bsdf(mi, 0.15, 0.7, 10.0)
+    return [
+        {  # a glass cylinder beside a white glossy ball, checkerboard wall
+            "camera": ([0.3, 1.4, 5.0], [0.0, 0.6, 0.0], 34.0),
+            "objects": {
+                "rod": (mesh(mi, m, "cyl", lambda: cylinder_mesh(0.45, 0.7), glass(1.5),
+                             [-0.5, 0.0, 0.3], scale=[1.0, 1.4, 1.0]), LABEL_TRANSPARENT),
+                "white": (sphere([0.9, 0.45, -0.2], 0.45, pplastic(0.85, 0.05)), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": floor(mi), "wall": backdrop(mi, -1.6, 8.0, 5.0, 0.0, board)},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.6}, "sun": sun([0.7, 1.0, 0.6], 2.5)},
+        },
+        {  # a glass superquadric and a glass torus under a lamp, checkerboard wall
+            "camera": ([-0.4, 1.5, 5.0], [0.0, 0.6, 0.0], 36.0),
+            "objects": {
+                "block": (mesh(mi, m, "rcube", lambda: rounded_cube_mesh(0.55), glass(1.5),
+                               [-0.7, 0.55, 0.0], rotate=[([0, 1, 0], 30)], scale=0.9), LABEL_TRANSPARENT),
+                "ring": (mesh(mi, m, "torus", lambda: torus_mesh(0.75, 0.3), glass(1.5),
+                              [0.9, 0.8, 0.2], rotate=[([1, 0, 0], 70)], scale=0.7), LABEL_TRANSPARENT),
+            },
+            "background": {"floor": floor(mi, bsdf={"type": "diffuse", "reflectance": 0.45}),
+                           "wall": backdrop(mi, -1.7, 8.0, 5.0, 0.0, board)},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.4},
+                         "lamp": sphere_light([-2.0, 3.5, 3.0], 0.5, 30.0)},
+        },
+        {  # a glass egg lying on the floor in front of a plain wall, a gold distractor
+            "camera": ([0.0, 1.8, 4.8], [0.0, 0.4, 0.0], 34.0),
+            "objects": {
+                "egg": (mesh(mi, m, "ell-lie", lambda: ellipsoid_mesh(0.7, 0.35, 0.45), glass(1.5),
+                             [-0.5, 0.35, 0.3], rotate=[([0, 1, 0], 20)]), LABEL_TRANSPARENT),
+                "gold": (sphere([1.0, 0.4, -0.3], 0.4, metal("Au", 0.05)), LABEL_METAL),
+            },
+            "background": {"floor": floor(mi, bsdf=checker_bsdf(mi, 0.3, 0.5, 8.0)),
+                           "wall": backdrop(mi, -1.5, 8.0, 5.0, 0.0, {"type": "diffuse", "reflectance": 0.6})},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.5}, "sun": sun([-0.6, 1.0, 0.7], 2.5)},
+        },
+    ]
+
+
+def haze_scenes_2(mi, m):
+    box = ([-20.0, -0.5, -45.0], [20.0, 12.0, 9.0])
+    ground = floor(mi, half=(19.0, 26.0), z=-17.0, bsdf={"type": "diffuse", "reflectance": 0.25})
+    return [
+        {  # cylinders and a vase receding into thin haze, sun from the left at right angles
+            "camera": ([0.0, 1.5, 6.0], [0.0, 1.2, -10.0], 48.0),
+            "objects": {
+                "drum": (mesh(mi, m, "cyl", lambda: cylinder_mesh(0.45, 0.7), pplastic(0.5, 0.1),
+                              [1.2, 0.0, 2.0], scale=1.5), LABEL_DIELECTRIC),
+                "vase": (mesh(mi, m, "vase", lambda: vase_mesh(1.3, 0.3, 0.25, 0.18), pplastic(0.4, 0.15),
+                              [-2.0, 0.0, -5.0], scale=2.0), LABEL_DIELECTRIC),
+                "tower": (mesh(mi, m, "cyl", lambda: cylinder_mesh(0.45, 0.7), pplastic(0.6, 0.1),
+                               [3.0, 0.0, -14.0], scale=[4.0, 8.0, 4.0]), LABEL_DIELECTRIC),
+                "hill": (sphere([-8.0, -1.0, -26.0], 5.0, pplastic(0.35, 0.2)), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": ground},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.35}, "sun": sun([-1.0, 0.4, 0.0], 3.0)},
+            "medium": {"box": box, "sigma_t": 0.045, "albedo": 1.0},
+        },
+        {  # boxy blocks in dense haze, sun high and behind the camera's right shoulder
+            "camera": ([-0.5, 1.4, 6.0], [0.5, 1.1, -10.0], 50.0),
+            "objects": {
+                "b1": (mesh(mi, m, "rcube8", lambda: rounded_cube_mesh(0.4, power=8.0), pplastic(0.5, 0.1),
+                            [-1.5, 1.0, 0.5], rotate=[([0, 1, 0], 25)], scale=2.5), LABEL_DIELECTRIC),
+                "b2": (mesh(mi, m, "rcube8", lambda: rounded_cube_mesh(0.4, power=8.0), pplastic(0.4, 0.1),
+                            [2.5, 1.6, -6.0], rotate=[([0, 1, 0], -15)], scale=4.0), LABEL_DIELECTRIC),
+                "ball": (sphere([-3.5, 2.0, -13.0], 2.0, pplastic(0.55, 0.15)), LABEL_DIELECTRIC),
+                "far": (mesh(mi, m, "rcube8", lambda: rounded_cube_mesh(0.4, power=8.0), pplastic(0.45, 0.2),
+                             [6.0, 4.0, -30.0], scale=10.0), LABEL_DIELECTRIC),
+            },
+            "background": {"floor": ground},
+            "emitters": {"sky": {"type": "constant", "radiance": 0.3}, "sun": sun([0.5, 0.8, 0.6], 3.0)},
+            "medium": {"box": box, "sigma_t": 0.11, "albedo": 1.0},
+        },
+    ]
+
+
 KINDS = {"shape": shape_scenes, "material": material_scenes, "glass": glass_scenes, "haze": haze_scenes,
-         "glasshard": glass_hard_scenes}
+         "glasshard": glass_hard_scenes, "shape2": shape_scenes_2, "material2": material_scenes_2,
+         "glass2": glass_scenes_2, "haze2": haze_scenes_2}
 
 
 # --------------------------------------------------------------------------- building and rendering
