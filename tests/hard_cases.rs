@@ -9,7 +9,7 @@ mod common;
 use std::path::Path;
 
 use common::{arg, vision};
-use polar_image::{Mosaic, NormalImage, StokesImage};
+use polar_image::{Gray, Mosaic, NormalImage, StokesImage};
 use polar_io::files;
 use polar_io::files::vision as out_files;
 
@@ -137,6 +137,52 @@ fn zero_and_undefined_pixels_inside_a_valid_frame() {
         _ => blob(40, 30, x, y),
     });
     run_all(&s);
+}
+
+/// `--objects` that cannot be used is a clear error naming the file, before any output: a
+/// mask missing, of another size than the frame, or `gt` where the sample has none. A mask
+/// found inside the sample directory is used (its pixels, and only those, get normals).
+#[test]
+fn object_masks_that_cannot_be_used_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("blob");
+    stokes_sample(&s, 40, 30, |x, y| blob(40, 30, x, y));
+    let out = dir.path().join("out");
+    let run = |objects: &str| {
+        vision(&[
+            "run",
+            arg(&s),
+            "--out",
+            arg(&out),
+            "--tasks",
+            "sfp",
+            "--objects",
+            objects,
+        ])
+    };
+    let err = run("nowhere.png").unwrap_err();
+    assert!(err.contains("nowhere.png"), "{err}");
+    polar_io::write_gray8_png(s.join("small.png"), &Gray::<u8>::new(39, 30)).unwrap();
+    let err = run("small.png").unwrap_err();
+    assert!(
+        err.contains("small.png") && err.contains("39x30, the frame 40x30"),
+        "{err}"
+    );
+    let err = run("gt").unwrap_err();
+    assert!(
+        err.contains("gt/material.png") && err.contains("missing"),
+        "{err}"
+    );
+    assert!(!out.exists(), "an output folder was left behind");
+    let mut mask = Gray::<u8>::new(40, 30);
+    mask.as_mut_slice()[..40 * 10].fill(255);
+    polar_io::write_gray8_png(s.join("top.png"), &mask).unwrap();
+    assert_eq!(run("top.png"), Ok(true));
+    let normals: NormalImage =
+        polar_io::read_exr(out.join(out_files::NORMAL), ["R", "G", "B"]).unwrap();
+    for (k, n) in normals.pixels().iter().enumerate() {
+        assert_eq!(n.iter().any(|v| *v != 0.0), k < 40 * 10, "pixel {k}: {n:?}");
+    }
 }
 
 #[test]

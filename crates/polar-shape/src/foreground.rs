@@ -232,6 +232,18 @@ pub fn foreground(cues: &Cues) -> Result<Vec<bool>, ShapeError> {
     }
 }
 
+/// The foreground of a given object mask `objects` (`w × h`): its valid pixels, with the
+/// invalid regions it mostly surrounds ([`with_enclosed_invalid`]).
+pub(crate) fn given(
+    valid: &[bool],
+    w: usize,
+    h: usize,
+    objects: &[bool],
+) -> Result<Vec<bool>, ShapeError> {
+    let fg = valid.iter().zip(objects).map(|(&v, &o)| v && o).collect();
+    with_enclosed_invalid(valid, w, h, fg)
+}
+
 /// `fg` with the regions of invalid pixels (saturated highlights) inside the frame of
 /// which at least [`INVALID_ENCLOSURE`] of the 4-neighbours around them are `fg`: a
 /// highlight on an object is part of it, and a hole there would be an occluding contour to

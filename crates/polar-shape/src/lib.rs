@@ -63,6 +63,9 @@ pub enum ShapeError {
     /// The refractive index is not a finite number above 1.
     #[error("refractive index {0} is not a finite number > 1")]
     InvalidIor(f64),
+    /// A given object mask is not of the observation's size.
+    #[error("the object mask is {0:?}, the observation {1:?}")]
+    ObjectsSize((usize, usize), (usize, usize)),
     /// A method or integrator name that is not known.
     #[error("unknown {kind} `{name}` (known: {known})")]
     UnknownName {
@@ -284,10 +287,29 @@ pub struct Shape {
 /// Errors: an empty observation, an invalid `opts.ior`, or a solver failure. An all-dark
 /// or all-invalid frame is not an error: it gives no foreground, zero normals and NaN depth.
 pub fn estimate_shape(obs: &Observation, opts: &ShapeOptions) -> Result<Shape, ShapeError> {
+    estimate_shape_of(obs, opts, None)
+}
+
+/// [`estimate_shape`] with the object pixels given (`objects`, non-zero on objects, the
+/// observation's size) in place of the foreground [`foreground::foreground`] finds: for a
+/// mask from elsewhere, or to evaluate the rest of the method with a known mask, as
+/// shape-from-polarization benchmarks give one. Its valid pixels are the foreground, with
+/// the invalid regions it mostly surrounds; at a working scale a block is foreground
+/// where at least half of its pixels are.
+pub fn estimate_shape_of(
+    obs: &Observation,
+    opts: &ShapeOptions,
+    objects: Option<&Gray<u8>>,
+) -> Result<Shape, ShapeError> {
     let (w, h) = obs.size();
     if w == 0 || h == 0 {
         return Err(ShapeError::Empty(w, h));
     }
+    if let Some(m) = objects.filter(|m| m.size() != (w, h)) {
+        return Err(ShapeError::ObjectsSize(m.size(), (w, h)));
+    }
+    let objects: Option<Vec<bool>> =
+        objects.map(|m| m.as_slice().iter().map(|&v| v != 0).collect());
     let given = match opts.ior {
         IorOption::Given(n) => n,
         IorOption::Default | IorOption::Estimate => DEFAULT_IOR,
@@ -296,10 +318,12 @@ pub fn estimate_shape(obs: &Observation, opts: &ShapeOptions) -> Result<Shape, S
         return Err(ShapeError::InvalidIor(given));
     }
     match scale::working_factor(w, h, opts.working_size) {
-        1 => estimate_at_scale(obs, opts, given),
+        1 => estimate_at_scale(obs, opts, given, objects.as_deref()),
         f => {
-            let coarse = estimate_at_scale(&obs.binned(f), opts, given)?;
-            scale::Grid { w, h, f }.upsample(coarse, obs)
+            let grid = scale::Grid { w, h, f };
+            let coarse_objects = objects.as_deref().map(|m| grid.majority(m));
+            let coarse = estimate_at_scale(&obs.binned(f), opts, given, coarse_objects.as_deref())?;
+            grid.upsample(coarse, obs, objects.as_deref())
         }
     }
 }
@@ -309,11 +333,15 @@ fn estimate_at_scale(
     obs: &Observation,
     opts: &ShapeOptions,
     given: f64,
+    objects: Option<&[bool]>,
 ) -> Result<Shape, ShapeError> {
     let (w, h) = obs.size();
     // The foreground does not depend on the index, so the index can be estimated on it.
     let mut cues = cues::Cues::new(obs, given)?;
-    let fg = foreground::foreground(&cues)?;
+    let fg = match objects {
+        Some(m) => foreground::given(&cues.valid, w, h, m)?,
+        None => foreground::foreground(&cues)?,
+    };
     let (ior, ior_source) = choose_ior(&cues, &fg, opts.ior)?;
     if ior != given {
         cues.models = zenith::ZenithModels::new(ior);

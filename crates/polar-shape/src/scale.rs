@@ -51,19 +51,32 @@ impl Grid {
     }
 
     /// The shape of the fine observation `obs` from `coarse`, the shape of `obs` binned:
-    /// the foreground, reflection types and confidence of each pixel's block, normals and
+    /// the foreground (a given object mask's own pixels, else each pixel's block's),
+    /// reflection types and confidence of each pixel's block, normals and
     /// depth interpolated bilinearly between block centres (depth in fine pixels). The
     /// fine pixels that are not [`usable`] are foreground where the fine foreground
     /// encloses them, as at the working scale (`foreground::with_enclosed_invalid`), with
     /// normals and depth but neither a reflection type nor a confidence.
-    pub fn upsample(&self, coarse: Shape, obs: &Observation) -> Result<Shape, ShapeError> {
+    pub fn upsample(
+        &self,
+        coarse: Shape,
+        obs: &Observation,
+        objects: Option<&[bool]>,
+    ) -> Result<Shape, ShapeError> {
         let (w, h) = (self.w, self.h);
         let valid: Vec<bool> = (0..w * h).into_par_iter().map(|k| usable(obs, k)).collect();
-        // The foreground's measured pixels; as at the working scale, the unmeasured ones it
-        // encloses join it without a confidence or a type.
+        // The foreground's measured pixels (a given object mask's own, else the block's);
+        // as at the working scale, the unmeasured ones it encloses join it without a
+        // confidence or a type.
         let measured: Vec<bool> = (0..w * h)
             .into_par_iter()
-            .map(|k| coarse.foreground.as_slice()[self.block(k)] != 0 && valid[k])
+            .map(|k| {
+                valid[k]
+                    && match objects {
+                        Some(m) => m[k],
+                        None => coarse.foreground.as_slice()[self.block(k)] != 0,
+                    }
+            })
             .collect();
         let fg = with_enclosed_invalid(&valid, w, h, measured.clone())?;
         let cn = coarse.normal.pixels();
@@ -97,6 +110,19 @@ impl Grid {
                 .expect("sized"),
             ..coarse
         })
+    }
+
+    /// A fine `w × h` mask on the coarse grid: a block is set where at least half of its
+    /// pixels are.
+    pub fn majority(&self, fine: &[bool]) -> Vec<bool> {
+        let (cw, ch) = self.coarse();
+        let mut counts = vec![[0usize; 2]; cw * ch];
+        for (k, &v) in fine.iter().enumerate() {
+            let c = &mut counts[self.block(k)];
+            c[0] += 1;
+            c[1] += usize::from(v);
+        }
+        counts.iter().map(|[n, on]| 2 * on >= *n).collect()
     }
 
     /// Each foreground pixel takes its block's value, the others `T::default()`.

@@ -108,6 +108,14 @@ pub enum CliError {
         /// The missing file.
         file: &'static str,
     },
+    /// The object mask of `--objects` cannot be used.
+    #[error("{path}: cannot use as the object mask (--objects): {reason}")]
+    Objects {
+        /// The mask file.
+        path: PathBuf,
+        /// Why not.
+        reason: String,
+    },
     /// Ground truth of another size than the input.
     #[error("{sample}: the input is {}x{} but its ground truth is {}x{} (a half-resolution demosaicing such as superpixel cannot be scored)", input.0, input.1, gt.0, gt.1)]
     GtSize {

@@ -6,7 +6,8 @@ use std::time::Instant;
 
 use clap::Args;
 use polar_eval::{SCHEMA_VERSION, Summary};
-use polar_io::files::vision;
+use polar_image::Gray;
+use polar_io::files::{self, vision};
 use polar_io::{GroundTruth, Validation};
 use serde::{Deserialize, Serialize};
 
@@ -14,8 +15,8 @@ use crate::error::CliError;
 use crate::input::{InputArgs, InputFile, Source, camera_model, read_input, resolve};
 use crate::out_dir;
 use crate::stokes::{Output, Planes, write_outputs};
-use crate::task_options::TaskArgs;
-use crate::tasks::{Context, Failure, Task};
+use crate::task_options::{ObjectsSource, TaskArgs};
+use crate::tasks::{Context, Failure, Task, object_mask};
 
 /// Arguments of `polar-vision run`.
 #[derive(Debug, Args)]
@@ -119,6 +120,12 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
         None => GroundTruth::default(),
     };
     check_gt_size(sample, &gt, obs.size())?;
+    let known_objects = args
+        .task
+        .objects
+        .as_ref()
+        .map(|source| read_objects(source, sample, &gt, obs.size()))
+        .transpose()?;
     let read_seconds = start.elapsed().as_secs_f64();
     let raw_mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let staged = out_dir::stage(out)?;
@@ -135,6 +142,7 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
         gt: &gt,
         out,
         radiance_per_unit: radiance_per_unit(&file, dir, &obs, &gt)?,
+        known_objects,
         normals: None,
         objects: None,
         transparent: None,
@@ -212,6 +220,44 @@ fn file_name(file: &InputFile) -> String {
 
 fn has_any(gt: &GroundTruth) -> bool {
     *gt != GroundTruth::default()
+}
+
+/// The object mask `--objects` names for `sample`, of the frame's `size`: the sample's
+/// gt/material.png (label not 0), or a PNG file, as given where it exists and else inside
+/// the sample directory.
+fn read_objects(
+    source: &ObjectsSource,
+    sample: &Path,
+    gt: &GroundTruth,
+    size: (usize, usize),
+) -> Result<Gray<u8>, CliError> {
+    let (path, mask) = match source {
+        ObjectsSource::GroundTruth => {
+            let path = sample.join(files::GT_MATERIAL);
+            let mask = object_mask(gt).ok_or_else(|| CliError::Objects {
+                path: path.clone(),
+                reason: "missing (--objects gt reads the sample's ground truth)".into(),
+            })?;
+            (path, mask)
+        }
+        ObjectsSource::File(p) => {
+            let path = if p.exists() || p.is_absolute() || !sample.is_dir() {
+                p.clone()
+            } else {
+                sample.join(p)
+            };
+            let mask = polar_io::read_gray8_png(&path)?;
+            (path, mask)
+        }
+    };
+    if mask.size() != size {
+        let ((w, h), (fw, fh)) = (mask.size(), size);
+        return Err(CliError::Objects {
+            path,
+            reason: format!("it is {w}x{h}, the frame {fw}x{fh}"),
+        });
+    }
+    Ok(mask)
 }
 
 /// Ground truth of another size than the input cannot be scored: a clear error.

@@ -72,6 +72,14 @@ pub struct TaskArgs {
     #[arg(verbatim_doc_comment)]
     #[arg(long, value_name = "NAME", default_value = "cues", value_parser = parse_name::<TransparentMethod>)]
     pub transparent_method: TransparentMethod,
+    /// The object pixels for sfp and material, in place of sfp's own foreground: `gt` (the
+    /// sample's gt/material.png, label not 0: shape from polarization scored with a known
+    /// object mask, as published benchmarks give one) or an 8-bit PNG of the frame's size,
+    /// non-zero on objects (a mask from another segmenter). A relative FILE that does not
+    /// exist as given is looked for in the sample directory, so `eval --objects mask.png`
+    /// reads each sample's own.
+    #[arg(long, value_name = "gt|FILE", value_parser = parse_objects)]
+    pub objects: Option<ObjectsSource>,
     /// The model file of `--transparent-method learned` (made by `polar-vision train
     /// transparent`), or `builtin` (the default) for the model shipped with the program
     /// (trained on datasets-synth/suites/transparent-train.toml).
@@ -188,6 +196,23 @@ where
     T::Err: std::fmt::Display,
 {
     s.parse().map_err(|e: T::Err| e.to_string())
+}
+
+/// Where `--objects` takes the object mask from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ObjectsSource {
+    /// The sample's gt/material.png, label not 0.
+    GroundTruth,
+    /// An 8-bit PNG, non-zero on objects.
+    File(PathBuf),
+}
+
+fn parse_objects(s: &str) -> Result<ObjectsSource, String> {
+    match s {
+        "" => Err("an empty path".into()),
+        "gt" => Ok(ObjectsSource::GroundTruth),
+        _ => Ok(ObjectsSource::File(s.into())),
+    }
 }
 
 fn parse_fov(s: &str) -> Result<f64, String> {

@@ -62,6 +62,8 @@ pub struct Context<'a> {
     pub out: &'a Path,
     /// Ground-truth radiance per unit of the observation's S0, where known (see `run`).
     pub radiance_per_unit: Option<f64>,
+    /// The object mask of `--objects`, which `sfp` takes for its foreground.
+    pub known_objects: Option<Gray<u8>>,
     /// Normals from `sfp`, for `material`.
     pub normals: Option<NormalImage>,
     /// Object mask from `sfp` (255 on objects), for `material`.

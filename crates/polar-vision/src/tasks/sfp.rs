@@ -8,7 +8,7 @@ use polar_imgproc::angular_error_map;
 use polar_io::RGB_CHANNELS;
 use polar_io::files::vision::{self, pictures};
 use polar_shape::global::Light;
-use polar_shape::{Shape, ShapeOptions, estimate_shape};
+use polar_shape::{Shape, ShapeOptions, estimate_shape_of};
 
 use super::{
     Context, Failure, NOISY, Outcome, SPARSE, io, object_mask, picture_path, to_json, write_plane,
@@ -23,7 +23,8 @@ const REFLECTION_NAMES: [&str; 4] = ["none", "diffuse", "specular", "mixed"];
 /// The shape estimate of the options in `args`, without writing anything (also for
 /// `material` when this task was not requested).
 pub fn estimate(ctx: &Context<'_>, args: &TaskArgs) -> Result<Shape, Failure> {
-    estimate_shape(ctx.obs, &options(args)).map_err(|e| Failure::CannotRun(e.to_string()))
+    estimate_shape_of(ctx.obs, &options(args), ctx.known_objects.as_ref())
+        .map_err(|e| Failure::CannotRun(e.to_string()))
 }
 
 fn options(args: &TaskArgs) -> ShapeOptions {
@@ -47,8 +48,13 @@ pub fn run(ctx: &mut Context<'_>, args: &TaskArgs) -> Result<Outcome, Failure> {
         .iter()
         .filter(|&&v| v != 0)
         .count();
+    let given = if ctx.known_objects.is_some() {
+        " (the mask of --objects)"
+    } else {
+        ""
+    };
     outcome.messages.push(format!(
-        "{} with index {:.3}, {}; {}; {objects} pixels on objects",
+        "{} with index {:.3}, {}; {}; {objects} pixels on objects{given}",
         opts.method,
         shape.ior,
         shape.ior_source,
