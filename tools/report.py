@@ -52,11 +52,13 @@ TASKS = {
         "local + fc": ["--sfp-method", "local", "--integrator", "fc"],
         "global": ["--sfp-method", "global"],
         "local, bilinear demosaic": ["--sfp-method", "local", "--demosaic", "bilinear"],
+        "local, known object mask": ["--sfp-method", "local", "--objects", "gt"],
     }),
     ("material", "material"): (["materials", "mts-material"], "metal_vs_dielectric_accuracy",
                                "metal vs dielectric accuracy", False, {
         "physics rule, with sfp normals": ["--tasks", "sfp,material"],
         "kNN, builtin model, with sfp normals": ["--tasks", "sfp,material", "--material-model", "builtin"],
+        "physics rule, known object mask": ["--tasks", "sfp,material", "--objects", "gt"],
     }),
     ("transparent", "transparent"): (["glass"], "iou", "mask IoU", False, {
         "training-free": [],
