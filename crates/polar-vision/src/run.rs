@@ -233,10 +233,13 @@ fn read_objects(
 ) -> Result<Gray<u8>, CliError> {
     let (path, mask) = match source {
         ObjectsSource::GroundTruth => {
-            let path = sample.join(files::GT_MATERIAL);
+            let path = match sample.is_dir() {
+                true => sample.join(files::GT_MATERIAL),
+                false => sample.to_owned(),
+            };
             let mask = object_mask(gt).ok_or_else(|| CliError::Objects {
                 path: path.clone(),
-                reason: "missing (--objects gt reads the sample's ground truth)".into(),
+                reason: "missing: --objects gt reads a sample directory's gt/material.png".into(),
             })?;
             (path, mask)
         }
