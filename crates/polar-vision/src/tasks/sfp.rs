@@ -21,7 +21,7 @@ use crate::writes::Writes;
 const REFLECTION_NAMES: [&str; 4] = ["none", "diffuse", "specular", "mixed"];
 
 /// The shape estimate of the options in `args`, without writing anything (also for
-/// `material` when this task was not requested).
+/// `material` when sfp is not among the tasks).
 pub fn estimate(ctx: &Context<'_>, args: &TaskArgs) -> Result<Shape, Failure> {
     estimate_shape_of(ctx.obs, &options(args), ctx.known_objects.as_ref())
         .map_err(|e| Failure::CannotRun(e.to_string()))
