@@ -46,7 +46,8 @@
 //! 2. holes are filled unless an occluding contour bounds them: the diffuse DoLP peaks
 //!    at grazing, so around a hole seen through an object (a torus) the DoLP is highest
 //!    next to the hole, while around a patch facing the camera (low DoLP) it rises away
-//!    from it (`fill_object_holes`);
+//!    from it, and around a highlight it is the same on both sides, the difference within
+//!    the noise (`fill_object_holes`);
 //! 3. a hole is also left open when its median log brightness is closer to the
 //!    background's around the regions than to the region's around it
 //!    (`looks_through`): background seen through the object;
@@ -860,7 +861,8 @@ pub fn rayleigh_statistic(cues: &Cues) -> Result<Gray<f32>, ShapeError> {
 
 /// `m` with its enclosed holes filled, except holes bounded by an occluding contour: the
 /// mean DoLP of the object pixels within [`RING_NEAR`] steps of the hole above that of
-/// the pixels [`RING_NEAR`] to [`RING_FAR`] steps away (module doc, B.2).
+/// the pixels [`RING_NEAR`] to [`RING_FAR`] steps away ([`dolp_rises_toward`]; module
+/// doc, B.2).
 fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let filled = fill_holes(m, w, h)?;
@@ -872,8 +874,9 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
     // Breadth-first from all holes at once over the region: each pixel joins the ring
     // sums of the hole that reaches it first.
     let (owner, dist) = grow_labels(&hole_id, w, h, RING_FAR, |j| m[j]);
-    // Per hole: [near DoLP sum, near count, far DoLP sum, far count].
-    let mut rings = vec![[0.0f64; 4]; n + 1];
+    // Per hole: [near DoLP sum, near count, far DoLP sum, far count, near DoLP² sum,
+    // far DoLP² sum].
+    let mut rings = vec![[0.0f64; 6]; n + 1];
     // Per hole: log brightness of the hole and of the region around it.
     let mut inside: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
     let mut around: Vec<Vec<f32>> = vec![Vec::new(); n + 1];
@@ -885,8 +888,10 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
         }
         around[o].push(log_brightness(cues, k));
         let slot = if dist[k] <= RING_NEAR { 0 } else { 2 };
-        rings[o][slot] += f64::from(cues.dolp[k]);
+        let d = f64::from(cues.dolp[k]);
+        rings[o][slot] += d;
         rings[o][slot + 1] += 1.0;
+        rings[o][4 + slot / 2] += d * d;
     }
     let outside = ring(&filled, w, h, 1..=RING_FAR)
         .into_iter()
@@ -896,8 +901,7 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
     let outside = median(outside);
     let open_hole: Vec<bool> = (0..=n)
         .map(|i| {
-            let r = rings[i];
-            let contour = r[1] > 0.0 && r[3] > 0.0 && r[0] / r[1] > r[2] / r[3];
+            let contour = dolp_rises_toward(&rings[i]);
             contour
                 || looks_through(
                     median(std::mem::take(&mut inside[i])),
@@ -909,6 +913,21 @@ fn fill_object_holes(cues: &Cues, m: &[bool]) -> Result<Vec<bool>, ShapeError> {
     Ok((0..w * h)
         .map(|k| m[k] || (holes[k] && !open_hole[hole_id[k] as usize]))
         .collect())
+}
+
+/// Whether the mean DoLP of a hole's near ring is above its far ring's by more than
+/// [`CONTOUR_SIGNIFICANCE`] standard errors of the difference (Welch's statistic;
+/// `r`: near sum, count, far sum, count, near sum of squares, far sum of squares): on a
+/// highlight's edge the two rings are alike and the difference only noise.
+pub(crate) fn dolp_rises_toward(r: &[f64; 6]) -> bool {
+    let [near, n_near, far, n_far, near_sq, far_sq] = *r;
+    if n_near < 2.0 || n_far < 2.0 {
+        return false;
+    }
+    let (m_near, m_far) = (near / n_near, far / n_far);
+    let var = |sq: f64, m: f64, n: f64| (sq / n - m * m).max(0.0) / (n - 1.0);
+    let se = (var(near_sq, m_near, n_near) + var(far_sq, m_far, n_far)).sqrt();
+    m_near - m_far > CONTOUR_SIGNIFICANCE * se
 }
 
 /// `ln(S0 + floor)` of pixel `k` (normalised S0, [`DARK_FLOOR`]).
