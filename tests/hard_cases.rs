@@ -8,7 +8,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{arg, vision};
+use common::{arg, json, vision};
 use polar_image::{Gray, Mosaic, NormalImage, StokesImage};
 use polar_io::files;
 use polar_io::files::vision as out_files;
@@ -141,7 +141,8 @@ fn zero_and_undefined_pixels_inside_a_valid_frame() {
 
 /// `--objects` that cannot be used is a clear error naming the file, before any output: a
 /// mask missing, of another size than the frame, or `gt` where the sample has none. A mask
-/// found inside the sample directory is used (its pixels, and only those, get normals).
+/// found inside the sample directory is used (its pixels, and only those, get normals);
+/// one that marks no pixel is used with a warning.
 #[test]
 fn object_masks_that_cannot_be_used_are_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -183,6 +184,20 @@ fn object_masks_that_cannot_be_used_are_clear_errors() {
     for (k, n) in normals.pixels().iter().enumerate() {
         assert_eq!(n.iter().any(|v| *v != 0.0), k < 40 * 10, "pixel {k}: {n:?}");
     }
+    // A mask without any object runs, with a warning in the sample's report.
+    polar_io::write_gray8_png(s.join("none.png"), &Gray::<u8>::new(40, 30)).unwrap();
+    std::fs::remove_dir_all(&out).unwrap();
+    let report = dir.path().join("eval");
+    let eval = ["eval", arg(dir.path()), "--out", arg(&report)];
+    let args = [&eval[..], &["--tasks", "sfp", "--objects", "none.png"]].concat();
+    assert_eq!(vision(&args), Ok(true));
+    let warnings = json(&report.join("metrics.json"))["samples"]["blob"]["Ok"]["warnings"].clone();
+    assert!(
+        warnings
+            .to_string()
+            .contains("none.png: the object mask marks no pixel"),
+        "{warnings}"
+    );
 }
 
 #[test]

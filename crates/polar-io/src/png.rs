@@ -90,6 +90,40 @@ pub fn read_gray8_png(path: impl AsRef<Path>) -> Result<Gray<u8>> {
     gray_from_vec(path, d.size, d.bytes)
 }
 
+/// Reads an object mask as any segmenter may write it: a PNG of any colour type and bit
+/// depth, 255 where a colour sample is non-zero and the alpha, where the file has one, is
+/// non-zero (a transparent pixel is nothing), else 0. A palette image counts by its
+/// colours (a black entry is background), grayscale of 1 to 16 bits by value.
+pub fn read_mask_png(path: impl AsRef<Path>) -> Result<Gray<u8>> {
+    let path = path.as_ref();
+    let expand = png::Transformations::EXPAND;
+    let d = decode_with(path, open(path)?, expand, |_, _| Ok(()))?;
+    let bytes = usize::from(d.depth == png::BitDepth::Sixteen) + 1;
+    let samples = d.color.samples();
+    let colours = match d.color {
+        png::ColorType::GrayscaleAlpha | png::ColorType::Rgba => samples - 1,
+        _ => samples,
+    };
+    let pixel = samples * bytes;
+    let (w, h) = d.size;
+    if d.bytes.len() != w * h * pixel {
+        return Err(Error::corrupt(
+            path,
+            "PNG",
+            "decoded size does not match its header",
+        ));
+    }
+    let on = |p: &[u8]| {
+        let (colour, alpha) = p.split_at(colours * bytes);
+        colour.iter().any(|&b| b != 0) && (alpha.is_empty() || alpha.iter().any(|&b| b != 0))
+    };
+    let mask = d
+        .bytes
+        .chunks_exact(pixel)
+        .map(|p| if on(p) { u8::MAX } else { 0 });
+    gray_from_vec(path, d.size, mask.collect())
+}
+
 /// Accepts grayscale of a bit depth in `bits` (described by `expected`).
 fn gray_of_depth(
     path: &Path,
@@ -321,11 +355,21 @@ fn decode(
     reader: impl BufRead + Seek,
     accept: impl FnOnce(png::ColorType, png::BitDepth) -> Result<()>,
 ) -> Result<Decoded> {
+    decode_with(path, reader, png::Transformations::IDENTITY, accept)
+}
+
+/// [`decode`] with the `png` crate's `transformations` applied to the samples.
+fn decode_with(
+    path: &Path,
+    reader: impl BufRead + Seek,
+    transformations: png::Transformations,
+    accept: impl FnOnce(png::ColorType, png::BitDepth) -> Result<()>,
+) -> Result<Decoded> {
     let limits = png::Limits {
         bytes: MAX_DECODED_BYTES,
     };
     let mut decoder = png::Decoder::new_with_limits(reader, limits);
-    decoder.set_transformations(png::Transformations::IDENTITY);
+    decoder.set_transformations(transformations);
     let mut reader = decoder.read_info().map_err(|e| decode_error(path, e))?;
     let info = reader.info();
     crate::check_pixels(path, info.width as usize, info.height as usize)?;
@@ -347,6 +391,7 @@ fn decode(
             .to_vec()
     });
     Ok(Decoded {
+        color: frame.color_type,
         depth: frame.bit_depth,
         size: (frame.width as usize, frame.height as usize),
         bytes,
@@ -356,6 +401,7 @@ fn decode(
 
 /// A decoded PNG, samples as stored.
 struct Decoded {
+    color: png::ColorType,
     depth: png::BitDepth,
     size: (usize, usize),
     bytes: Vec<u8>,

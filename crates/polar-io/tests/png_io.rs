@@ -4,9 +4,9 @@ use std::path::{Path, PathBuf};
 
 use polar_image::{Gray, Image};
 use polar_io::{
-    BitDepth, Error, GrayPng, MosaicPng, read_gray_png, read_gray8_png, read_mosaic, read_rgb8_png,
-    write_gray_png, write_gray8_png, write_gray16_png, write_indexed8_png_rows, write_rgb8_png,
-    write_rgb8_png_rows,
+    BitDepth, Error, GrayPng, MosaicPng, read_gray_png, read_gray8_png, read_mask_png, read_mosaic,
+    read_rgb8_png, write_gray_png, write_gray8_png, write_gray16_png, write_indexed8_png_rows,
+    write_rgb8_png, write_rgb8_png_rows,
 };
 
 fn ramp8(width: usize, height: usize) -> Gray<u8> {
@@ -396,6 +396,89 @@ fn zero_sized_image_cannot_be_written() {
                 ..
             }
         ),
+        "{err}"
+    );
+}
+
+/// An object mask reads the same from every layout a segmenter may write: the object is
+/// where a colour sample is non-zero (a 16-bit label 1, a blue-only pixel, a palette
+/// entry that is not black) and the pixel is not transparent; a truncated mask is a
+/// corrupt file.
+#[test]
+fn object_masks_read_alike_from_every_png_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (8u32, 4u32);
+    let object = |k: usize| k.is_multiple_of(3);
+    let expected = Gray::from_vec(
+        w as usize,
+        h as usize,
+        (0..(w * h) as usize)
+            .map(|k| if object(k) { 255 } else { 0 })
+            .collect(),
+    )
+    .unwrap();
+    let per_pixel = |on: &[u8], off: &[u8]| -> Vec<u8> {
+        (0..(w * h) as usize)
+            .flat_map(|k| if object(k) { on.to_vec() } else { off.to_vec() })
+            .collect()
+    };
+    let one_bit: Vec<u8> = (0..h as usize)
+        .flat_map(|y| {
+            let mut row = [0u8; 1];
+            for x in 0..w as usize {
+                row[0] |= u8::from(object(y * w as usize + x)) << (7 - x);
+            }
+            row
+        })
+        .collect();
+    use png::{BitDepth as D, ColorType as C};
+    let layouts: [(&str, C, D, Vec<u8>); 6] = [
+        ("gray8", C::Grayscale, D::Eight, per_pixel(&[1], &[0])),
+        (
+            "gray16",
+            C::Grayscale,
+            D::Sixteen,
+            per_pixel(&[0, 1], &[0, 0]),
+        ),
+        ("gray1", C::Grayscale, D::One, one_bit),
+        ("rgb", C::Rgb, D::Eight, per_pixel(&[0, 0, 9], &[0, 0, 0])),
+        (
+            "gray-alpha",
+            C::GrayscaleAlpha,
+            D::Eight,
+            per_pixel(&[200, 255], &[200, 0]),
+        ),
+        (
+            "rgba",
+            C::Rgba,
+            D::Eight,
+            per_pixel(&[255, 255, 255, 1], &[255, 255, 255, 0]),
+        ),
+    ];
+    for (name, color, depth, data) in layouts {
+        let path = dir.path().join(format!("{name}.png"));
+        write_raw_png(&path, w, h, color, depth, &data);
+        assert_eq!(read_mask_png(&path).unwrap(), expected, "{name}");
+    }
+    let path = dir.path().join("palette.png");
+    let palette = [[0, 0, 0], [128, 0, 0], [0, 0, 0]];
+    write_indexed8_png_rows(&path, (w as usize, h as usize), &palette, |y, row| {
+        for (x, b) in row.iter_mut().enumerate() {
+            *b = if object(y * w as usize + x) {
+                1
+            } else {
+                2 * (x % 2) as u8
+            };
+        }
+    })
+    .unwrap();
+    assert_eq!(read_mask_png(&path).unwrap(), expected, "palette");
+    let bytes = std::fs::read(&path).unwrap();
+    let cut = dir.path().join("cut.png");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let err = read_mask_png(&cut).unwrap_err();
+    assert!(
+        matches!(&err, Error::Corrupt { format: "PNG", .. }),
         "{err}"
     );
 }

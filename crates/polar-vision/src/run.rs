@@ -113,7 +113,7 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
     let dir = sample.is_dir().then_some(sample);
     let meta = dir.map(polar_io::read_optional_meta).transpose()?.flatten();
     let reading = read_input(&file, &args.read)?;
-    let (mut obs, warnings) = (reading.obs, reading.warnings);
+    let (mut obs, mut warnings) = (reading.obs, reading.warnings);
     obs.camera = camera_model(args.task.fov, meta.as_ref());
     let gt = match dir {
         Some(d) => polar_io::read_ground_truth(d, Validation::Check)?,
@@ -126,6 +126,15 @@ pub fn run_sample(sample: &Path, out: &Path, args: &RunArgs) -> Result<SampleRep
         .as_ref()
         .map(|source| read_objects(source, sample, &gt, obs.size()))
         .transpose()?;
+    if let Some((path, mask)) = &known_objects
+        && mask.as_slice().iter().all(|&v| v == 0)
+    {
+        warnings.push(format!(
+            "{}: the object mask marks no pixel; the tasks that take it find no object",
+            path.display()
+        ));
+    }
+    let known_objects = known_objects.map(|(_, mask)| mask);
     let read_seconds = start.elapsed().as_secs_f64();
     let raw_mask = matches!(file, InputFile::Raw(_)).then_some(&obs.flags);
     let staged = out_dir::stage(out)?;
@@ -222,15 +231,16 @@ fn has_any(gt: &GroundTruth) -> bool {
     *gt != GroundTruth::default()
 }
 
-/// The object mask `--objects` names for `sample`, of the frame's `size`: the sample's
-/// gt/material.png (label not 0), or a PNG file, as given where it exists and else inside
-/// the sample directory.
+/// The object mask `--objects` names for `sample`, of the frame's `size`, and the file it
+/// came from: the sample's gt/material.png (label not 0), or a PNG file
+/// ([`polar_io::read_mask_png`]), as given where it exists and else inside the sample
+/// directory.
 fn read_objects(
     source: &ObjectsSource,
     sample: &Path,
     gt: &GroundTruth,
     size: (usize, usize),
-) -> Result<Gray<u8>, CliError> {
+) -> Result<(PathBuf, Gray<u8>), CliError> {
     let (path, mask) = match source {
         ObjectsSource::GroundTruth => {
             let path = match sample.is_dir() {
@@ -249,7 +259,7 @@ fn read_objects(
             } else {
                 sample.join(p)
             };
-            let mask = polar_io::read_gray8_png(&path)?;
+            let mask = polar_io::read_mask_png(&path)?;
             (path, mask)
         }
     };
@@ -260,7 +270,7 @@ fn read_objects(
             reason: format!("it is {w}x{h}, the frame {fw}x{fh}"),
         });
     }
-    Ok(mask)
+    Ok((path, mask))
 }
 
 /// Ground truth of another size than the input cannot be scored: a clear error.

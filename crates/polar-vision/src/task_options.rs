@@ -74,8 +74,9 @@ pub struct TaskArgs {
     pub transparent_method: TransparentMethod,
     /// The object pixels for sfp and material, in place of sfp's own foreground: `gt` (the
     /// sample's gt/material.png, label not 0: shape from polarization scored with a known
-    /// object mask, as published benchmarks give one) or an 8-bit PNG of the frame's size,
-    /// non-zero on objects (a mask from another segmenter). A relative FILE that does not
+    /// object mask, as published benchmarks give one) or a PNG of the frame's size from
+    /// another segmenter, non-zero on objects (grayscale of any depth, RGB, palette; a
+    /// transparent pixel is background). A relative FILE that does not
     /// exist as given is looked for in the sample directory, so `eval --objects mask.png`
     /// reads each sample's own.
     #[arg(long, value_name = "gt|FILE", value_parser = parse_objects)]
@@ -203,7 +204,7 @@ where
 pub enum ObjectsSource {
     /// The sample's gt/material.png, label not 0.
     GroundTruth,
-    /// An 8-bit PNG, non-zero on objects.
+    /// A PNG, non-zero on objects ([`polar_io::read_mask_png`]).
     File(PathBuf),
 }
 
