@@ -40,7 +40,9 @@ pub struct InputArgs {
     #[arg(long, value_name = "NAME", default_value = "residual", value_parser = parse_method)]
     pub demosaic: DemosaicMethod,
     /// Significant bits of the sensor data (8, 10, 12 or 16). Default: the PNG's
-    /// sample depth. Use 10 or 12 for such sensors stored in 16-bit PNGs, with --align.
+    /// sample depth, less the low bits that are 0 in every sample of a 16-bit PNG (data
+    /// aligned left, read as --align left would). Use 10 or 12 for such sensors stored in
+    /// 16-bit PNGs, with --align; 16 reads the samples as they are.
     #[arg(long, value_name = "BITS", value_parser = clap::builder::PossibleValuesParser::new(["8", "10", "12", "16"]))]
     pub bit_depth: Option<String>,
     /// Where fewer-bit data sit in a 16-bit PNG: `right` (values 0..2^bits-1) or `left`
@@ -243,7 +245,13 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
     let mut timings = Timings::default();
     let png = timings.time("read raw.png", || polar_io::read_mosaic(path))?;
     let (raw, level, warnings) = timings.time("exposure checks", || {
-        let (raw, bits) = significant_bits(path, png, bits, args.align)?;
+        let (raw, bits, note) = match bits {
+            Some(bits) => {
+                let (raw, bits) = significant_bits(path, png, bits, args.align)?;
+                (raw, bits, None)
+            }
+            None => left_aligned_as_found(path, png),
+        };
         let (w, h) = raw.size();
         pattern
             .check_size(w, h)
@@ -253,8 +261,10 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
                 source,
             })?;
         let level = saturation_level(&raw, bits);
-        let warnings = check_exposure(path, &raw, bits, level)?;
-        Ok::<_, CliError>((raw, level, warnings))
+        let warnings = note
+            .into_iter()
+            .chain(check_exposure(path, &raw, bits, level)?);
+        Ok::<_, CliError>((raw, level, warnings.collect()))
     })?;
     let demosaic = "demosaic + products";
     let (planes, flags, colors) = match pattern {
@@ -317,15 +327,50 @@ pub fn saturation_level(raw: &Mosaic<u16>, bits: u8) -> u32 {
     if adc_top && at_max >= 2 { max } else { full }
 }
 
-/// Applies `--bit-depth`/`--align`: returns the samples as right-aligned DN and their bit count.
+/// A 16-bit PNG read without `--bit-depth`: where every sample's `k` low bits are zero
+/// (`1 <= k <= 8`), the data are `16 − k`-bit data aligned left (a camera's 10- or 12-bit
+/// ADC): they are shifted right, as `--bit-depth 16−k --align left` would, so their DN,
+/// saturation level and quantisation step are the data's, and a frame reads the same
+/// aligned either way. Returns the samples, their bit count and a note for the user.
+fn left_aligned_as_found(path: &Path, png: MosaicPng) -> (Mosaic<u16>, u8, Option<String>) {
+    let container = png.bit_depth.bits();
+    let mut raw = png.image;
+    let any_bits = raw
+        .as_slice()
+        .par_iter()
+        .fold(|| 0u16, |a, &v| a | v)
+        .reduce(|| 0, |a, b| a | b);
+    let zeros = if container == 16 && any_bits != 0 {
+        any_bits.trailing_zeros().min(8) as u8
+    } else {
+        0
+    };
+    if zeros == 0 {
+        return (raw, container, None);
+    }
+    raw.as_mut_slice().par_iter_mut().for_each(|v| *v >>= zeros);
+    let bits = container - zeros;
+    let low = match zeros {
+        1 => "low bit of every sample is".to_owned(),
+        n => format!("low {n} bits of every sample are"),
+    };
+    let note = format!(
+        "{}: the {low} 0: read as {bits}-bit data aligned left (--bit-depth 16 reads the \
+         samples as they are)",
+        path.display()
+    );
+    (raw, bits, Some(note))
+}
+
+/// Applies `--bit-depth`/`--align`: returns the samples as right-aligned DN and their bit
+/// count.
 fn significant_bits(
     path: &Path,
     png: MosaicPng,
-    bits: Option<u8>,
+    bits: u8,
     align: Align,
 ) -> Result<(Mosaic<u16>, u8), CliError> {
     let container = png.bit_depth.bits();
-    let bits = bits.unwrap_or(container);
     if bits > container {
         return Err(CliError::BitDepthTooLarge {
             path: path.to_owned(),

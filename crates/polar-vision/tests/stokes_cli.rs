@@ -640,3 +640,58 @@ fn help_explains_the_colour_pattern() {
         assert!(help.contains(needle), "help lacks {needle}:\n{help}");
     }
 }
+
+/// Without `--bit-depth`, 12-bit data aligned left in a 16-bit PNG (its low 4 bits 0 in
+/// every sample) read as `--bit-depth 12 --align left` would: the same DN as the
+/// right-aligned file, its ADC top (4095 << 4) flagged as saturated, and a note that says
+/// so; `--bit-depth 16` reads the samples as they are.
+#[test]
+fn left_aligned_data_are_found_without_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut right: Mosaic<u16> = Mosaic::from_vec(
+        8,
+        8,
+        (0..64).map(|i| (101 + i * 61 % 3900) as u16).collect(),
+    )
+    .unwrap();
+    right.as_mut_slice()[..2].fill(4095);
+    let left = Mosaic::from_vec(8, 8, right.as_slice().iter().map(|v| v << 4).collect()).unwrap();
+    let (rp, lp) = (dir.path().join("right.png"), dir.path().join("left.png"));
+    polar_io::write_gray16_png(&rp, &right).unwrap();
+    polar_io::write_gray16_png(&lp, &left).unwrap();
+    let (o1, o2, o3) = (
+        dir.path().join("o1"),
+        dir.path().join("o2"),
+        dir.path().join("o3"),
+    );
+    let ok = run(&["stokes", p(&rp), "--out", p(&o1)]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    assert!(!stderr(&ok).contains("aligned left"), "{}", stderr(&ok));
+    let found = run(&["stokes", p(&lp), "--out", p(&o2)]);
+    assert!(found.status.success(), "{}", stderr(&found));
+    assert!(
+        stderr(&found)
+            .contains("low 4 bits of every sample are 0: read as 12-bit data aligned left"),
+        "{}",
+        stderr(&found)
+    );
+    let s = |o: &Path| polar_io::read_exr_channel(o.join(vision::STOKES), "S0").unwrap();
+    assert_eq!(s(&o1), s(&o2), "both alignments give the same DN");
+    let mask = polar_io::read_gray8_png(o2.join(vision::MASK)).unwrap();
+    assert_eq!(mask.pixel(0, 0)[0], polar_sensor::mask::SATURATED);
+    let as_is = run(&["stokes", p(&lp), "--out", p(&o3), "--bit-depth", "16"]);
+    assert!(as_is.status.success(), "{}", stderr(&as_is));
+    assert!(
+        !stderr(&as_is).contains("aligned left"),
+        "{}",
+        stderr(&as_is)
+    );
+    // In the container's DN: 16 times as large (the residual demosaicing's one-DN weight
+    // floor is then a sixteenth of the data's step, so not exactly 16 times).
+    let sum = |o: &Path| s(o).as_slice().iter().map(|&v| f64::from(v)).sum::<f64>();
+    let ratio = sum(&o3) / sum(&o1);
+    assert!(
+        (ratio - 16.0).abs() < 0.01,
+        "--bit-depth 16: S0 ratio {ratio}"
+    );
+}
