@@ -105,14 +105,6 @@ pub fn read_mask_png(path: impl AsRef<Path>) -> Result<Gray<u8>> {
         _ => samples,
     };
     let pixel = samples * bytes;
-    let (w, h) = d.size;
-    if d.bytes.len() != w * h * pixel {
-        return Err(Error::corrupt(
-            path,
-            "PNG",
-            "decoded size does not match its header",
-        ));
-    }
     let on = |p: &[u8]| {
         let (colour, alpha) = p.split_at(colours * bytes);
         colour.iter().any(|&b| b != 0) && (alpha.is_empty() || alpha.iter().any(|&b| b != 0))
