@@ -34,6 +34,18 @@ pub enum CliError {
         /// Bits per sample in the file.
         container: u8,
     },
+    /// `--black-level` leaves no signal below the saturation level.
+    #[error(
+        "{path}: --black-level {black} DN is at or above the saturation level ({level} DN): no signal is left"
+    )]
+    BlackLevel {
+        /// The file.
+        path: PathBuf,
+        /// The black level given.
+        black: u16,
+        /// The saturation level of the data.
+        level: u32,
+    },
     /// Data does not fit the declared alignment.
     #[error(
         "{path}: pixel ({x}, {y}) = {value} is not {bits}-bit {align}-aligned data in a {container}-bit PNG{hint}"

@@ -49,6 +49,12 @@ pub struct InputArgs {
     /// (shifted up, low bits zero). Outputs are in DN of the --bit-depth data either way.
     #[arg(long, value_enum, default_value_t = Align::Right)]
     pub align: Align,
+    /// The sensor's black level (pedestal), in DN of the data (after --bit-depth and
+    /// --align): subtracted from every sample, at 0 the least, before demosaicing; the
+    /// saturated samples are found before. A pedestal left in adds unpolarized light and
+    /// lowers every DoLP. Default 0: the camera already subtracted it.
+    #[arg(long, value_name = "DN", default_value_t = 0)]
+    pub black_level: u16,
     /// Filters over a raw mosaic: `mono` (IMX250MZR: polarizers only) or `rgb` (IMX250MYR:
     /// 2x2 polarizer blocks under an RGGB Bayer pattern, width and height multiples of 4;
     /// polanalyser's COLOR_PolarRGB). Default: `sensor.pattern` of the sample's meta.json
@@ -261,6 +267,7 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
                 source,
             })?;
         let level = saturation_level(&raw, bits);
+        let (raw, level) = without_black_level(path, raw, level, args)?;
         let warnings = note
             .into_iter()
             .chain(check_exposure(path, &raw, bits, level)?);
@@ -325,6 +332,32 @@ pub fn saturation_level(raw: &Mosaic<u16>, bits: u8) -> u32 {
         .count();
     let adc_top = (8..bits).any(|b| max == (1u32 << b) - 1);
     if adc_top && at_max >= 2 { max } else { full }
+}
+
+/// `raw` less `--black-level` (at 0 the least) and its saturation `level` less the same:
+/// the samples at the level stay flagged. A black level at or above the saturation level
+/// leaves no signal: an error.
+fn without_black_level(
+    path: &Path,
+    mut raw: Mosaic<u16>,
+    level: u32,
+    args: &InputArgs,
+) -> Result<(Mosaic<u16>, u32), CliError> {
+    let black = args.black_level;
+    if black == 0 {
+        return Ok((raw, level));
+    }
+    if u32::from(black) >= level {
+        return Err(CliError::BlackLevel {
+            path: path.to_owned(),
+            black,
+            level,
+        });
+    }
+    raw.as_mut_slice()
+        .par_iter_mut()
+        .for_each(|v| *v = v.saturating_sub(black));
+    Ok((raw, level - u32::from(black)))
 }
 
 /// A 16-bit PNG read without `--bit-depth`: where every sample's `k` low bits are zero

@@ -695,3 +695,82 @@ fn left_aligned_data_are_found_without_options() {
         "--bit-depth 16: S0 ratio {ratio}"
     );
 }
+
+/// `--black-level` takes the sensor's pedestal off every sample before demosaicing: a
+/// polarized frame with 64 DN added reads, with `--black-level 64`, exactly as the frame
+/// without it (and, without the option, less polarized); its saturated samples stay
+/// flagged; a black level at the saturation level is a clear error.
+#[test]
+fn black_level_is_taken_off_before_demosaicing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (16, 16);
+    let angle = |x: usize, y: usize| {
+        polar_sensor::layout::CHANNEL_ANGLES_DEG[polar_sensor::layout::channel_at(x, y)]
+            .to_radians()
+    };
+    let sample = |x: usize, y: usize| {
+        let (s0, s1, s2) = (2000.0 + 40.0 * x as f64, 400.0, 200.0 + 10.0 * y as f64);
+        let a = 2.0 * angle(x, y);
+        (0.5 * (s0 + s1 * a.cos() + s2 * a.sin())).round() as u16
+    };
+    let frame = |pedestal: u16| {
+        let mut m: Mosaic<u16> = Mosaic::from_vec(
+            w,
+            h,
+            (0..w * h)
+                .map(|k| sample(k % w, k / w) + pedestal)
+                .collect(),
+        )
+        .unwrap();
+        m.as_mut_slice()[..2].fill(4095);
+        m
+    };
+    let (clean, lifted) = (dir.path().join("clean.png"), dir.path().join("lifted.png"));
+    polar_io::write_gray16_png(&clean, &frame(0)).unwrap();
+    polar_io::write_gray16_png(&lifted, &frame(64)).unwrap();
+    let stokes = |input: &Path, options: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let res = run(&[&["stokes", p(input), "--out", p(&out)], options].concat());
+        assert!(res.status.success(), "{}", stderr(&res));
+        out
+    };
+    let reference = stokes(&clean, &[], "reference");
+    let corrected = stokes(&lifted, &["--black-level", "64"], "corrected");
+    let dolp = |o: &Path| polar_io::read_exr_channel(o.join(vision::DOLP), "Y").unwrap();
+    let mask = polar_io::read_gray8_png(corrected.join(vision::MASK)).unwrap();
+    assert_eq!(mask.pixel(0, 0)[0], polar_sensor::mask::SATURATED);
+    // Equal wherever the flagged samples (4095 in both files, so 4095 and 4031 once the
+    // pedestal is off) do not reach.
+    let unflagged = |o: &Path| -> Vec<f32> {
+        let d = dolp(o);
+        (0..w * h)
+            .filter(|&k| mask.as_slice()[k] == 0)
+            .map(|k| d.as_slice()[k])
+            .collect()
+    };
+    assert!(unflagged(&reference).len() > w * h / 2);
+    assert_eq!(unflagged(&reference), unflagged(&corrected));
+    let lowered = stokes(&lifted, &[], "lowered");
+    let mean = |o: &Path| {
+        dolp(o)
+            .as_slice()
+            .iter()
+            .map(|&v| f64::from(v))
+            .sum::<f64>()
+    };
+    assert!(
+        mean(&lowered) < 0.97 * mean(&reference),
+        "a pedestal lowers the DoLP"
+    );
+    fails_with(
+        &[
+            "stokes",
+            p(&lifted),
+            "--out",
+            p(&dir.path().join("x")),
+            "--black-level",
+            "4095",
+        ],
+        "no signal is left",
+    );
+}
