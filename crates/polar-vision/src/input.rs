@@ -251,13 +251,11 @@ fn read_raw(path: &Path, args: &InputArgs) -> Result<Reading, CliError> {
     let mut timings = Timings::default();
     let png = timings.time("read raw.png", || polar_io::read_mosaic(path))?;
     let (raw, level, warnings) = timings.time("exposure checks", || {
-        let (raw, bits, note) = match bits {
-            Some(bits) => {
-                let (raw, bits) = significant_bits(path, png, bits, args.align)?;
-                (raw, bits, None)
-            }
-            None => left_aligned_as_found(path, png),
+        let (bits, align, note) = match bits {
+            Some(bits) => (bits, args.align, None),
+            None => alignment_as_found(path, &png),
         };
+        let (raw, bits) = significant_bits(path, png, bits, align)?;
         let (w, h) = raw.size();
         pattern
             .check_size(w, h)
@@ -360,15 +358,15 @@ fn without_black_level(
     Ok((raw, level - u32::from(black)))
 }
 
-/// A 16-bit PNG read without `--bit-depth`: where every sample's `k` low bits are zero
-/// (`1 <= k <= 8`), the data are `16 − k`-bit data aligned left (a camera's 10- or 12-bit
-/// ADC): they are shifted right, as `--bit-depth 16−k --align left` would, so their DN,
-/// saturation level and quantisation step are the data's, and a frame reads the same
-/// aligned either way. Returns the samples, their bit count and a note for the user.
-fn left_aligned_as_found(path: &Path, png: MosaicPng) -> (Mosaic<u16>, u8, Option<String>) {
+/// The bits and alignment of a PNG read without `--bit-depth`: where every sample of a
+/// 16-bit PNG has its `k` low bits zero (`1 <= k <= 8`), `16 − k`-bit data aligned left
+/// (a camera's 10- or 12-bit ADC), read as `--bit-depth 16−k --align left` would, so their
+/// DN, saturation level and quantisation step are the data's and a frame reads the same
+/// aligned either way, with a note for the user; else the PNG's sample depth.
+fn alignment_as_found(path: &Path, png: &MosaicPng) -> (u8, Align, Option<String>) {
     let container = png.bit_depth.bits();
-    let mut raw = png.image;
-    let any_bits = raw
+    let any_bits = png
+        .image
         .as_slice()
         .par_iter()
         .fold(|| 0u16, |a, &v| a | v)
@@ -379,9 +377,8 @@ fn left_aligned_as_found(path: &Path, png: MosaicPng) -> (Mosaic<u16>, u8, Optio
         0
     };
     if zeros == 0 {
-        return (raw, container, None);
+        return (container, Align::Right, None);
     }
-    raw.as_mut_slice().par_iter_mut().for_each(|v| *v >>= zeros);
     let bits = container - zeros;
     let low = match zeros {
         1 => "low bit of every sample is".to_owned(),
@@ -392,7 +389,7 @@ fn left_aligned_as_found(path: &Path, png: MosaicPng) -> (Mosaic<u16>, u8, Optio
          samples as they are)",
         path.display()
     );
-    (raw, bits, Some(note))
+    (bits, Align::Left, Some(note))
 }
 
 /// Applies `--bit-depth`/`--align`: returns the samples as right-aligned DN and their bit
