@@ -228,8 +228,10 @@ fn shape_from_polarization_on_the_ci_shape_family() {
 
 /// With `--objects gt` sfp's foreground is the true object mask: every object pixel gets a
 /// normal but the few the front end could not measure (coverage measured 1.000; bound
-/// 0.99), and the error falls (mean measured 12.3 degrees against 15.2 with sfp's own
-/// foreground; bound: no larger).
+/// 0.99), and the error falls (mean measured 9.7 degrees against 15.2 with sfp's own
+/// foreground). Bound: at least 4 degrees lower, which takes the prior weighing along the
+/// whole given outline (`polar_shape::local::Outline::Given`); weighing only where the
+/// outline's polarization verifies it as a contour, the fall measured 2.9 degrees.
 #[test]
 fn shape_from_polarization_with_the_known_object_mask() {
     let (_, own) = eval("sfp", "sfp", "2");
@@ -242,7 +244,7 @@ fn shape_from_polarization_with_the_known_object_mask() {
     );
     assert!(coverage > 0.99, "coverage {coverage}");
     assert!(
-        mean <= own_mean,
+        mean + 4.0 <= own_mean,
         "mean {mean}, with sfp's own foreground {own_mean}"
     );
 }

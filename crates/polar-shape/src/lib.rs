@@ -43,6 +43,7 @@ mod tests;
 use std::fmt;
 use std::str::FromStr;
 
+use crate::local::Outline;
 use nalgebra::Vector3;
 use polar_image::{Gray, Image, NormalImage};
 use polar_sensor::Observation;
@@ -338,15 +339,15 @@ fn estimate_at_scale(
     let (w, h) = obs.size();
     // The foreground does not depend on the index, so the index can be estimated on it.
     let mut cues = cues::Cues::new(obs, given)?;
-    let fg = match objects {
-        Some(m) => foreground::given(&cues.valid, w, h, m)?,
-        None => foreground::foreground(&cues)?,
+    let (fg, outline) = match objects {
+        Some(m) => (foreground::given(&cues.valid, w, h, m)?, Outline::Given),
+        None => (foreground::foreground(&cues)?, Outline::Found),
     };
     let (ior, ior_source) = choose_ior(&cues, &fg, opts.ior)?;
     if ior != given {
         cues.models = zenith::ZenithModels::new(ior);
     }
-    let local = local::disambiguate(&cues, &fg)?;
+    let local = local::disambiguate(&cues, &fg, outline)?;
     let light = global::fit_light(&cues, &fg, &local);
     let est = match opts.method {
         Method::Local => local,

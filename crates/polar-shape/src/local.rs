@@ -10,7 +10,8 @@
 //!    It starts the iterations everywhere but weighs in them only where the nearest
 //!    boundary shows the occluding-contour signature in its polarization
 //!    (`verified_contour`), so a cast shadow or a missed part of an object does not
-//!    pull the normals toward a boundary that is not a silhouette.
+//!    pull the normals toward a boundary that is not a silhouette. A given object mask
+//!    ([`Outline::Given`]) is the objects' outline: all of it weighs.
 //! 2. Candidates per pixel, in the per-pixel Stokes frame: diffuse azimuths `AoLP`,
 //!    `AoLP + π` and specular ones `AoLP ± π/2`. Observed light mixes diffuse, specular
 //!    and unpolarized parts, so DoLP only bounds the zenith (`DoLP ≤ ρ(θ)` of the
@@ -99,9 +100,20 @@ pub struct Prior {
     pub rim: Vec<bool>,
 }
 
+/// Where the foreground's outline comes from, which decides how far the prior trusts it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outline {
+    /// Found in the image ([`crate::foreground::foreground`]): parts of it may be a cast
+    /// shadow's edge or a cut through a missed part of an object, so the prior weighs
+    /// only where the nearest boundary is a verified occluding contour.
+    Found,
+    /// Given with the object mask: all of it is the objects' occluding contour.
+    Given,
+}
+
 /// Disambiguated normals of the foreground pixels.
-pub fn disambiguate(cues: &Cues, fg: &[bool]) -> Result<Estimate, ShapeError> {
-    disambiguate_with(cues, fg, &boundary_prior(cues, fg)?)
+pub fn disambiguate(cues: &Cues, fg: &[bool], outline: Outline) -> Result<Estimate, ShapeError> {
+    disambiguate_with(cues, fg, &boundary_prior(cues, fg, outline)?)
 }
 
 /// [`disambiguate`] with a given prior.
@@ -330,10 +342,10 @@ fn smooth_field(
 }
 
 /// The occluding-boundary prior of step 1 (module doc). It starts the iterations
-/// everywhere, but weighs in them only where the nearest boundary is a verified
-/// occluding contour (`verified_contour`), or everywhere when no part of the boundary
-/// is.
-pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
+/// everywhere, but on a found outline weighs in them only where the nearest boundary is
+/// a verified occluding contour (`verified_contour`), or everywhere when no part of the
+/// boundary is.
+pub fn boundary_prior(cues: &Cues, fg: &[bool], outline: Outline) -> Result<Prior, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let n = w * h;
     let dist = distance_to_background(fg, w, h, Outside::NotBackground);
@@ -349,7 +361,10 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool]) -> Result<Prior, ShapeError> {
     }
     let radius = component_max(fg, &dist, w, h)?;
     let outward = outward_directions(&dist, w, h)?;
-    let seeds = verified_contour(cues, fg, &dist, &outward)?;
+    let seeds = match outline {
+        Outline::Found => verified_contour(cues, fg, &dist, &outward)?,
+        Outline::Given => Vec::new(),
+    };
     let to_verified = if seeds.iter().any(|&s| s) {
         let not_seed: Vec<bool> = seeds.iter().map(|&s| !s).collect();
         distance_to_background(&not_seed, w, h, Outside::NotBackground)

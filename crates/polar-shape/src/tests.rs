@@ -642,7 +642,7 @@ fn specular_rim_marks_the_specular_object_only() {
         .iter()
         .map(|n| n.norm_squared() > 0.0)
         .collect();
-    let prior = crate::local::boundary_prior(&cues, &fg).unwrap();
+    let prior = crate::local::boundary_prior(&cues, &fg, crate::local::Outline::Found).unwrap();
     for k in (0..fg.len()).filter(|&k| fg[k]) {
         assert_eq!(prior.specular_rim[k], on_left[k], "pixel {k}");
     }
@@ -1170,8 +1170,9 @@ fn merged_cast_shadow_does_not_steer_the_prior() {
         .collect();
     let shadow = |k: usize| (70..92).contains(&(k % 96)) && (36..60).contains(&(k / 96));
     let fg: Vec<bool> = (0..truth.len()).map(|k| truth[k] || shadow(k)).collect();
-    let prior = crate::local::boundary_prior(&cues, &fg).unwrap();
-    let sphere_only = crate::local::boundary_prior(&cues, &truth).unwrap();
+    let prior = crate::local::boundary_prior(&cues, &fg, crate::local::Outline::Found).unwrap();
+    let sphere_only =
+        crate::local::boundary_prior(&cues, &truth, crate::local::Outline::Found).unwrap();
     // Shadow pixels more than 6 pixels (three window sigmas along the boundary) from
     // the sphere: their nearest boundary is the shadow's own.
     let off_sphere: Vec<bool> = truth.iter().map(|t| !t).collect();
@@ -1206,6 +1207,58 @@ fn merged_cast_shadow_does_not_steer_the_prior() {
         .filter(|&&k| sphere_only.weight[k] > 0.5)
         .count();
     assert!(rim > 20, "too few weighted rim pixels: {rim}");
+}
+
+/// A given object mask is the objects' outline, so its prior weighs along all of it: a
+/// sphere whose right rim shows no polarization (too dark, or depolarized) has that part
+/// of its contour unverified when the outline is found, and its normals there come out
+/// worse than when the same outline is given.
+#[test]
+fn a_given_outline_steers_the_prior_where_the_rim_shows_no_polarization() {
+    use crate::local::{Outline, boundary_prior, disambiguate};
+    let mut scene = sphere_scene(96, 1.5);
+    let fg: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    // The right half's outer band (true zenith beyond 45°) unpolarized.
+    let dark_rim: Vec<bool> = (0..fg.len())
+        .map(|k| fg[k] && k % 96 > 48 && scene.normals[k].z.abs() < 0.7)
+        .collect();
+    for (s, _) in scene.stokes.iter_mut().zip(&dark_rim).filter(|v| *v.1) {
+        (s[1], s[2]) = (0.0, 0.0);
+    }
+    let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
+    let error = |outline: Outline| {
+        let est = disambiguate(&cues, &fg, outline).unwrap();
+        let k: Vec<usize> = (0..fg.len()).filter(|&k| dark_rim[k]).collect();
+        let sum: f64 = k
+            .iter()
+            .map(|&k| {
+                est.normals[k]
+                    .dot(&scene.normals[k])
+                    .clamp(-1.0, 1.0)
+                    .acos()
+            })
+            .sum();
+        (sum / k.len() as f64).to_degrees()
+    };
+    let unverified = boundary_prior(&cues, &fg, Outline::Found).unwrap();
+    assert!(
+        (0..fg.len()).any(|k| dark_rim[k] && unverified.weight[k] == 0.0),
+        "the dark rim should be unverified on a found outline"
+    );
+    let given = boundary_prior(&cues, &fg, Outline::Given).unwrap();
+    assert!((0..fg.len()).all(|k| !dark_rim[k] || given.weight[k] > 0.0));
+    let (found, given) = (error(Outline::Found), error(Outline::Given));
+    // With its prior the band follows the sphere profile, which is exact here; without,
+    // the field flattens it toward the inner side. 5° is well below that flattening
+    // and well above the noise-free estimate's own error.
+    assert!(
+        given + 5.0 < found,
+        "given {given:.1}° against found {found:.1}°"
+    );
 }
 
 /// The shape of `obs` with the index estimated (local method).
@@ -1609,7 +1662,11 @@ fn rim_follows_curved_outlines_not_straight_edges() {
     let obs = uniform_observation(w, h, [0.4, 0.0, 0.0], CameraModel::Orthographic);
     let cues = Cues::new(&obs, 1.5).unwrap();
     let centre = |k: usize| ((k % w) as f64 - 31.5, (k / w) as f64 - 31.5);
-    let rim = |fg: &[bool]| crate::local::boundary_prior(&cues, fg).unwrap().rim;
+    let rim = |fg: &[bool]| {
+        crate::local::boundary_prior(&cues, fg, crate::local::Outline::Found)
+            .unwrap()
+            .rim
+    };
     // A disc: its whole outer ring (within 2 pixels of the outline) is rim.
     let radius = |k: usize| centre(k).0.hypot(centre(k).1);
     let disc: Vec<bool> = (0..w * h).map(|k| radius(k) < 24.0).collect();
