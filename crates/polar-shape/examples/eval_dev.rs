@@ -319,9 +319,12 @@ fn oracle_foreground(
         .zip(&cues.valid)
         .map(|(&m, &v)| m != 0 && v)
         .collect();
-    let prior =
-        polar_shape::local::boundary_prior(&cues, &true_fg, polar_shape::local::Outline::Given)
-            .unwrap();
+    let prior = polar_shape::local::boundary_prior(
+        &cues,
+        &true_fg,
+        polar_shape::local::Outline::Given(&true_fg),
+    )
+    .unwrap();
     let fg = if prior_only {
         polar_shape::foreground::foreground(&cues).unwrap()
     } else {

@@ -340,7 +340,7 @@ fn estimate_at_scale(
     // The foreground does not depend on the index, so the index can be estimated on it.
     let mut cues = cues::Cues::new(obs, given)?;
     let (fg, outline) = match objects {
-        Some(m) => (foreground::given(&cues.valid, w, h, m)?, Outline::Given),
+        Some(m) => (foreground::given(&cues.valid, w, h, m)?, Outline::Given(m)),
         None => (foreground::foreground(&cues)?, Outline::Found),
     };
     let (ior, ior_source) = choose_ior(&cues, &fg, opts.ior)?;

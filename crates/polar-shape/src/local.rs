@@ -100,15 +100,17 @@ pub struct Prior {
     pub rim: Vec<bool>,
 }
 
-/// Where the foreground's outline comes from, which decides how far the prior trusts it.
+/// Where the objects' outline comes from, which decides how far the prior trusts it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Outline {
-    /// Found in the image ([`crate::foreground::foreground`]): parts of it may be a cast
-    /// shadow's edge or a cut through a missed part of an object, so the prior weighs
-    /// only where the nearest boundary is a verified occluding contour.
+pub enum Outline<'a> {
+    /// The foreground's, found in the image ([`crate::foreground::foreground`]): parts
+    /// of it may be a cast shadow's edge or a cut through a missed part of an object, so
+    /// the prior weighs only where the nearest boundary is a verified occluding contour.
     Found,
-    /// Given with the object mask: all of it is the objects' occluding contour.
-    Given,
+    /// The given object mask's (non-zero on objects, the image's size): all of it is the
+    /// objects' occluding contour, unmeasured pixels at its edge (a saturated rim)
+    /// included.
+    Given(&'a [bool]),
 }
 
 /// Disambiguated normals of the foreground pixels.
@@ -341,14 +343,18 @@ fn smooth_field(
     Ok(())
 }
 
-/// The occluding-boundary prior of step 1 (module doc). It starts the iterations
-/// everywhere, but on a found outline weighs in them only where the nearest boundary is
-/// a verified occluding contour (`verified_contour`), or everywhere when no part of the
-/// boundary is.
+/// The occluding-boundary prior of step 1 (module doc) over the foreground `fg`. It starts
+/// the iterations everywhere, but on a found outline weighs in them only where the
+/// nearest boundary is a verified occluding contour (`verified_contour`), or everywhere
+/// when no part of the boundary is.
 pub fn boundary_prior(cues: &Cues, fg: &[bool], outline: Outline) -> Result<Prior, ShapeError> {
     let (w, h) = (cues.width, cues.height);
     let n = w * h;
-    let dist = distance_to_background(fg, w, h, Outside::NotBackground);
+    let objects = match outline {
+        Outline::Found => fg,
+        Outline::Given(objects) => objects,
+    };
+    let dist = distance_to_background(objects, w, h, Outside::NotBackground);
     if dist.iter().all(|d| !d.is_finite()) {
         // No contour: the prior faces the camera and carries no weight.
         let normal = (0..n).map(|k| -cues.frame(k).d).collect();
@@ -359,11 +365,11 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool], outline: Outline) -> Result<Prio
             rim: vec![false; n],
         });
     }
-    let radius = component_max(fg, &dist, w, h)?;
+    let radius = component_max(objects, &dist, w, h)?;
     let outward = outward_directions(&dist, w, h)?;
     let seeds = match outline {
         Outline::Found => verified_contour(cues, fg, &dist, &outward)?,
-        Outline::Given => Vec::new(),
+        Outline::Given(_) => Vec::new(),
     };
     let to_verified = if seeds.iter().any(|&s| s) {
         let not_seed: Vec<bool> = seeds.iter().map(|&s| !s).collect();
@@ -392,7 +398,7 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool], outline: Outline) -> Result<Prio
             )
         })
         .collect();
-    let curvature = outline_curvature(fg, &outward, w, h)?;
+    let curvature = outline_curvature(objects, &outward, w, h)?;
     let rim = (0..n)
         .map(|k| {
             fg[k]
@@ -403,7 +409,7 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool], outline: Outline) -> Result<Prio
     Ok(Prior {
         normal: out.iter().map(|v| v.0).collect(),
         weight: out.iter().map(|v| v.1).collect(),
-        specular_rim: specular_rims(cues, fg, &dist, &outward)?,
+        specular_rim: specular_rims(cues, objects, &dist, &outward)?,
         rim,
     })
 }

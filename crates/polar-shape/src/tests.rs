@@ -1249,15 +1249,75 @@ fn a_given_outline_steers_the_prior_where_the_rim_shows_no_polarization() {
         (0..fg.len()).any(|k| dark_rim[k] && unverified.weight[k] == 0.0),
         "the dark rim should be unverified on a found outline"
     );
-    let given = boundary_prior(&cues, &fg, Outline::Given).unwrap();
+    let given = boundary_prior(&cues, &fg, Outline::Given(&fg)).unwrap();
     assert!((0..fg.len()).all(|k| !dark_rim[k] || given.weight[k] > 0.0));
-    let (found, given) = (error(Outline::Found), error(Outline::Given));
+    let (found, given) = (error(Outline::Found), error(Outline::Given(&fg)));
     // With its prior the band follows the sphere profile, which is exact here; without,
     // the field flattens it toward the inner side. 5° is well below that flattening
     // and well above the noise-free estimate's own error.
     assert!(
         given + 5.0 < found,
         "given {given:.1}° against found {found:.1}°"
+    );
+}
+
+/// A saturated highlight on the rim of a given object is unmeasured, not background: the
+/// given mask's outline, not that of its measured pixels, steers the prior, so the normals
+/// next to the highlight do not turn away from it as from an occluding contour.
+#[test]
+fn a_saturated_rim_inside_a_given_mask_is_no_contour() {
+    use crate::local::{Outline, disambiguate};
+    let scene = sphere_scene(96, 1.5);
+    let (w, h) = (scene.width, scene.height);
+    let objects: Vec<bool> = scene
+        .normals
+        .iter()
+        .map(|n| n.norm_squared() > 0.0)
+        .collect();
+    // A highlight centred on the object's rightmost pixel of the middle row.
+    let row = h / 2;
+    let edge = (0..w).rev().find(|&x| objects[row * w + x]).unwrap();
+    let from_edge = |k: usize| ((k % w) as f64 - edge as f64).hypot((k / w) as f64 - row as f64);
+    let flags = (0..w * h)
+        .map(|k| {
+            if from_edge(k) <= 6.0 {
+                polar_sensor::mask::SATURATED
+            } else {
+                0
+            }
+        })
+        .collect();
+    let obs = scene
+        .observation(1.0)
+        .with_flags(polar_image::Gray::from_vec(w, h, flags).unwrap());
+    let cues = Cues::new(&obs, 1.5).unwrap();
+    let fg = crate::foreground::given(&cues.valid, w, h, &objects).unwrap();
+    assert!(
+        (0..w * h).any(|k| objects[k] && !fg[k]),
+        "the highlight, open to the background, should stay out of the foreground"
+    );
+    let ring: Vec<usize> = (0..w * h)
+        .filter(|&k| fg[k] && (6.0..10.0).contains(&from_edge(k)))
+        .collect();
+    let error = |outline: Outline| {
+        let est = disambiguate(&cues, &fg, outline).unwrap();
+        let sum: f64 = ring
+            .iter()
+            .map(|&k| {
+                est.normals[k]
+                    .dot(&scene.normals[k])
+                    .clamp(-1.0, 1.0)
+                    .acos()
+            })
+            .sum();
+        (sum / ring.len() as f64).to_degrees()
+    };
+    let (mask, measured) = (error(Outline::Given(&objects)), error(Outline::Given(&fg)));
+    // Taken for a contour, the highlight's edge turns the ring's normals away from it; on
+    // the mask's outline the ring is the exact sphere's. 5° lies well between the two.
+    assert!(
+        mask + 5.0 < measured,
+        "the mask's outline {mask:.1}° against the measured pixels' {measured:.1}°"
     );
 }
 
