@@ -76,7 +76,9 @@ pub struct TaskArgs {
     /// sample's gt/material.png, label not 0: shape from polarization scored with a known
     /// object mask, as published benchmarks give one) or a PNG of the frame's size from
     /// another segmenter, non-zero on objects (grayscale of any depth, RGB, palette; a
-    /// transparent pixel is background). A relative FILE that does not
+    /// transparent pixel is background). Its outline is taken for the objects' occluding
+    /// contour, where normals lie in the image plane: mark whole objects, since a cut
+    /// through one becomes a false rim. A relative FILE that does not
     /// exist as given is looked for in the sample directory, so `eval --objects mask.png`
     /// reads each sample's own.
     #[arg(long, value_name = "gt|FILE", value_parser = parse_objects)]
