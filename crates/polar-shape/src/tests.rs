@@ -1209,13 +1209,35 @@ fn merged_cast_shadow_does_not_steer_the_prior() {
     assert!(rim > 20, "too few weighted rim pixels: {rim}");
 }
 
+/// Mean angle (degrees) between the local method's normals of foreground `fg` with
+/// `outline` and `scene`'s true normals, over `pixels`.
+fn local_error(
+    cues: &Cues,
+    fg: &[bool],
+    outline: crate::local::Outline,
+    scene: &Scene,
+    pixels: &[usize],
+) -> f64 {
+    let est = crate::local::disambiguate(cues, fg, outline).unwrap();
+    let sum: f64 = pixels
+        .iter()
+        .map(|&k| {
+            est.normals[k]
+                .dot(&scene.normals[k])
+                .clamp(-1.0, 1.0)
+                .acos()
+        })
+        .sum();
+    (sum / pixels.len() as f64).to_degrees()
+}
+
 /// A given object mask is the objects' outline, so its prior weighs along all of it: a
 /// sphere whose right rim shows no polarization (too dark, or depolarized) has that part
 /// of its contour unverified when the outline is found, and its normals there come out
 /// worse than when the same outline is given.
 #[test]
 fn a_given_outline_steers_the_prior_where_the_rim_shows_no_polarization() {
-    use crate::local::{Outline, boundary_prior, disambiguate};
+    use crate::local::{Outline, boundary_prior};
     let mut scene = sphere_scene(96, 1.5);
     let fg: Vec<bool> = scene
         .normals
@@ -1230,20 +1252,8 @@ fn a_given_outline_steers_the_prior_where_the_rim_shows_no_polarization() {
         (s[1], s[2]) = (0.0, 0.0);
     }
     let cues = Cues::new(&scene.observation(1.0), 1.5).unwrap();
-    let error = |outline: Outline| {
-        let est = disambiguate(&cues, &fg, outline).unwrap();
-        let k: Vec<usize> = (0..fg.len()).filter(|&k| dark_rim[k]).collect();
-        let sum: f64 = k
-            .iter()
-            .map(|&k| {
-                est.normals[k]
-                    .dot(&scene.normals[k])
-                    .clamp(-1.0, 1.0)
-                    .acos()
-            })
-            .sum();
-        (sum / k.len() as f64).to_degrees()
-    };
+    let band: Vec<usize> = (0..fg.len()).filter(|&k| dark_rim[k]).collect();
+    let error = |outline| local_error(&cues, &fg, outline, &scene, &band);
     let unverified = boundary_prior(&cues, &fg, Outline::Found).unwrap();
     assert!(
         (0..fg.len()).any(|k| dark_rim[k] && unverified.weight[k] == 0.0),
@@ -1266,7 +1276,7 @@ fn a_given_outline_steers_the_prior_where_the_rim_shows_no_polarization() {
 /// next to the highlight do not turn away from it as from an occluding contour.
 #[test]
 fn a_saturated_rim_inside_a_given_mask_is_no_contour() {
-    use crate::local::{Outline, disambiguate};
+    use crate::local::Outline;
     let scene = sphere_scene(96, 1.5);
     let (w, h) = (scene.width, scene.height);
     let objects: Vec<bool> = scene
@@ -1278,18 +1288,7 @@ fn a_saturated_rim_inside_a_given_mask_is_no_contour() {
     let row = h / 2;
     let edge = (0..w).rev().find(|&x| objects[row * w + x]).unwrap();
     let from_edge = |k: usize| ((k % w) as f64 - edge as f64).hypot((k / w) as f64 - row as f64);
-    let flags = (0..w * h)
-        .map(|k| {
-            if from_edge(k) <= 6.0 {
-                polar_sensor::mask::SATURATED
-            } else {
-                0
-            }
-        })
-        .collect();
-    let obs = scene
-        .observation(1.0)
-        .with_flags(polar_image::Gray::from_vec(w, h, flags).unwrap());
+    let obs = with_saturated_disc(&scene, (edge as f64, row as f64), 6.0);
     let cues = Cues::new(&obs, 1.5).unwrap();
     let fg = crate::foreground::given(&cues.valid, w, h, &objects).unwrap();
     assert!(
@@ -1299,19 +1298,7 @@ fn a_saturated_rim_inside_a_given_mask_is_no_contour() {
     let ring: Vec<usize> = (0..w * h)
         .filter(|&k| fg[k] && (6.0..10.0).contains(&from_edge(k)))
         .collect();
-    let error = |outline: Outline| {
-        let est = disambiguate(&cues, &fg, outline).unwrap();
-        let sum: f64 = ring
-            .iter()
-            .map(|&k| {
-                est.normals[k]
-                    .dot(&scene.normals[k])
-                    .clamp(-1.0, 1.0)
-                    .acos()
-            })
-            .sum();
-        (sum / ring.len() as f64).to_degrees()
-    };
+    let error = |outline| local_error(&cues, &fg, outline, &scene, &ring);
     let (mask, measured) = (error(Outline::Given(&objects)), error(Outline::Given(&fg)));
     // Taken for a contour, the highlight's edge turns the ring's normals away from it; on
     // the mask's outline the ring is the exact sphere's. 5° lies well between the two.
@@ -1794,6 +1781,24 @@ fn saturated_highlight_keeps_its_normals_at_a_binned_working_scale() {
     );
 }
 
+/// `scene`'s observation with its pixels within `r` of `centre` flagged saturated, as
+/// the front end flags the demosaicing support of clipped samples (none for `r < 0`).
+fn with_saturated_disc(scene: &Scene, (cx, cy): (f64, f64), r: f64) -> Observation {
+    let (w, h) = (scene.width, scene.height);
+    let flags = (0..w * h)
+        .map(|k| {
+            if ((k % w) as f64 - cx).hypot((k / w) as f64 - cy) <= r {
+                polar_sensor::mask::SATURATED
+            } else {
+                0
+            }
+        })
+        .collect();
+    scene
+        .observation(1.0)
+        .with_flags(polar_image::Gray::from_vec(w, h, flags).unwrap())
+}
+
 /// The highlight of a 96-pixel sphere, `flagged` saturated or not, estimated at
 /// `working_size` (0: the camera's pixels): the highlight's pixels without a foreground
 /// normal and those with a reflection type or a confidence (their polarization is not
@@ -1804,18 +1809,7 @@ fn highlight_on_a_sphere(working_size: usize, flagged: bool) -> ([usize; 2], f64
     // Where the highlight of the light would sit, between the centre and the light.
     let (cx, cy, r) = (56.0, 36.0, 5.0);
     let from_centre = |k: usize| ((k % w) as f64 - cx).hypot((k / w) as f64 - cy);
-    let flags = (0..w * h)
-        .map(|k| {
-            if flagged && from_centre(k) <= r {
-                polar_sensor::mask::SATURATED
-            } else {
-                0
-            }
-        })
-        .collect();
-    let obs = scene
-        .observation(1.0)
-        .with_flags(polar_image::Gray::from_vec(w, h, flags).unwrap());
+    let obs = with_saturated_disc(&scene, (cx, cy), if flagged { r } else { -1.0 });
     let options = ShapeOptions {
         working_size,
         ..opts(Method::Local, Some(1.5))
