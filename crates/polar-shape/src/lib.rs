@@ -43,11 +43,12 @@ mod tests;
 use std::fmt;
 use std::str::FromStr;
 
-use crate::local::Outline;
 use nalgebra::Vector3;
 use polar_image::{Gray, Image, NormalImage};
 use polar_sensor::Observation;
 use thiserror::Error;
+
+use crate::local::Outline;
 
 /// The refractive index used when none is given (and where [`IorOption::Estimate`] finds
 /// too little evidence): typical plastics and glass (1.45–1.6). It is the default rather

@@ -367,15 +367,18 @@ pub fn boundary_prior(cues: &Cues, fg: &[bool], outline: Outline) -> Result<Prio
     }
     let radius = component_max(objects, &dist, w, h)?;
     let outward = outward_directions(&dist, w, h)?;
-    let seeds = match outline {
-        Outline::Found => verified_contour(cues, fg, &dist, &outward)?,
-        Outline::Given(_) => Vec::new(),
-    };
-    let to_verified = if seeds.iter().any(|&s| s) {
-        let not_seed: Vec<bool> = seeds.iter().map(|&s| !s).collect();
-        distance_to_background(&not_seed, w, h, Outside::NotBackground)
-    } else {
-        dist.clone()
+    // Distance to the nearest verified contour: on a given outline, the outline itself.
+    let to_verified = match outline {
+        Outline::Found => {
+            let seeds = verified_contour(cues, fg, &dist, &outward)?;
+            if seeds.iter().any(|&s| s) {
+                let not_seed: Vec<bool> = seeds.iter().map(|&s| !s).collect();
+                distance_to_background(&not_seed, w, h, Outside::NotBackground)
+            } else {
+                dist.clone()
+            }
+        }
+        Outline::Given(_) => dist.clone(),
     };
     let out: Vec<(Vector3<f64>, f64)> = (0..n)
         .into_par_iter()
