@@ -28,8 +28,17 @@ pub struct Target {
 }
 
 /// Every target, in the order of `tools/fuzz.sh`.
-pub const TARGETS: [Target; 9] = [
-    PNG_MOSAIC, EXR_STOKES, SAMPLE, META_JSON, MANIFEST, SCENE, SUITE, VISION_RUN, MODEL_FILE,
+pub const TARGETS: [Target; 10] = [
+    PNG_MOSAIC,
+    EXR_STOKES,
+    SAMPLE,
+    META_JSON,
+    MANIFEST,
+    SCENE,
+    SUITE,
+    VISION_RUN,
+    MODEL_FILE,
+    OBJECT_MASK,
 ];
 
 const MIB: usize = 1 << 20;
@@ -201,6 +210,25 @@ pub const MODEL_FILE: Target = Target {
         );
     },
     bound: |len| text_bound(len) + 8 * len,
+};
+
+/// The frame an [`OBJECT_MASK`] input goes with: the size of the seed dataset's images
+/// (`tools/fuzz.sh seed`), so that most of the corpus decodes.
+const MASK_FRAME: (usize, usize) = (16, 16);
+
+/// An object mask (`polar-vision run --objects FILE`) through `polar_io::read_mask_png_from`,
+/// which takes a PNG of any colour type and bit depth of the frame's size
+/// ([`MASK_FRAME`]). Bound: the rows expanded to at most 8 bytes per pixel (16-bit RGBA)
+/// of the frame, then the mask's byte per pixel, plus slack: a header of another size is
+/// refused before any pixel buffer exists.
+pub const OBJECT_MASK: Target = Target {
+    name: "object_mask",
+    run: |data| {
+        let path = Path::new("objects.png");
+        let mask = polar_io::read_mask_png_from(path, Cursor::new(data), MASK_FRAME);
+        named(mask, path);
+    },
+    bound: |_| 9 * MASK_FRAME.0 * MASK_FRAME.1 + SLACK,
 };
 
 /// Runs `target` on `data` and asserts its allocation bound.

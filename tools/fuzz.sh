@@ -7,7 +7,7 @@
 #   tools/fuzz.sh all [SECONDS]             run, then cmin, every target in turn
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
-targets=(png_mosaic exr_stokes sample meta_json manifest scene suite vision_run model_file)
+targets=(png_mosaic exr_stokes sample meta_json manifest scene suite vision_run model_file object_mask)
 # No sanitizer: the code under test has no `unsafe`, and without ASan a run does about
 # twice the executions. Debug assertions (-a) turn integer overflow into a finding.
 build_flags=(--sanitizer none --debug-assertions)
@@ -27,6 +27,7 @@ seed() {
         n=$(basename "$s")
         cp "$s/raw.png" "$c/png_mosaic/$n-raw.png"
         cp "$s/gt/material.png" "$c/png_mosaic/$n-material.png"
+        cp "$s/gt/material.png" "$c/object_mask/$n-material.png"
         cp "$s/stokes.exr" "$c/exr_stokes/$n-stokes.exr"
         cp "$s/gt/depth.exr" "$c/exr_stokes/$n-depth.exr"
         cp "$s/meta.json" "$c/meta_json/$n.json"

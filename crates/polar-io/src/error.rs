@@ -176,6 +176,17 @@ pub enum Error {
         /// The file the size was taken from.
         reference: PathBuf,
     },
+    /// An image that goes with a frame (an object mask) has another size, judged from its
+    /// header before its pixels are decoded.
+    #[error("{path}: it is {}x{}, the frame {}x{}", found.0, found.1, frame.0, frame.1)]
+    FrameSize {
+        /// The image.
+        path: PathBuf,
+        /// Its `(width, height)`.
+        found: (usize, usize),
+        /// The frame's `(width, height)`.
+        frame: (usize, usize),
+    },
     /// `meta.json` is valid JSON but not an object.
     #[error("{path}: meta.json must hold a JSON object, found {found}")]
     MetaNotObject {

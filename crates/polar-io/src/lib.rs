@@ -29,9 +29,9 @@ pub use openexr::{
 };
 pub use png::{
     BitDepth, GrayPng, MosaicPng, check_mosaic_size, read_gray_png, read_gray_png_from,
-    read_gray8_png, read_mask_png, read_mosaic, read_mosaic_from, read_rgb8_png, write_gray_png,
-    write_gray8_png, write_gray16_png, write_indexed8_png, write_indexed8_png_rows, write_rgb8_png,
-    write_rgb8_png_rows,
+    read_gray8_png, read_mask_png, read_mask_png_from, read_mosaic, read_mosaic_from,
+    read_rgb8_png, write_gray_png, write_gray8_png, write_gray16_png, write_indexed8_png,
+    write_indexed8_png_rows, write_rgb8_png, write_rgb8_png_rows,
 };
 pub use sample::{
     GroundTruth, MaterialLabel, Sample, TRANSPARENT_MASK_ON, files, parse_json, parse_meta,

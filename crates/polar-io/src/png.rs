@@ -93,11 +93,34 @@ pub fn read_gray8_png(path: impl AsRef<Path>) -> Result<Gray<u8>> {
 /// Reads an object mask as any segmenter may write it: a PNG of any colour type and bit
 /// depth, 255 where a colour sample is non-zero and the alpha, where the file has one, is
 /// non-zero (a transparent pixel is nothing), else 0. A palette image counts by its
-/// colours (a black entry is background), grayscale of 1 to 16 bits by value.
-pub fn read_mask_png(path: impl AsRef<Path>) -> Result<Gray<u8>> {
+/// colours (a black entry is background), grayscale of 1 to 16 bits by value. A mask of
+/// another size than the `frame` (`(width, height)`) it goes with is [`Error::FrameSize`],
+/// refused from its header: a file of a few bytes cannot make the reader hold the
+/// pixels of the largest image it accepts.
+pub fn read_mask_png(path: impl AsRef<Path>, frame: (usize, usize)) -> Result<Gray<u8>> {
     let path = path.as_ref();
+    read_mask_png_from(path, open(path)?, frame)
+}
+
+/// [`read_mask_png`] from any reader (e.g. bytes in memory); `path` only names it in errors.
+pub fn read_mask_png_from(
+    path: &Path,
+    reader: impl BufRead + Seek,
+    frame: (usize, usize),
+) -> Result<Gray<u8>> {
+    let same_size = |info: &png::Info| {
+        let found = (info.width as usize, info.height as usize);
+        match found == frame {
+            true => Ok(()),
+            false => Err(Error::FrameSize {
+                path: path.to_owned(),
+                found,
+                frame,
+            }),
+        }
+    };
     let expand = png::Transformations::EXPAND;
-    let d = decode_with(path, open(path)?, expand, |_, _| Ok(()))?;
+    let d = decode_with(path, reader, expand, same_size)?;
     let bytes = usize::from(d.depth == png::BitDepth::Sixteen) + 1;
     let samples = d.color.samples();
     let colours = match d.color {
@@ -347,15 +370,17 @@ fn decode(
     reader: impl BufRead + Seek,
     accept: impl FnOnce(png::ColorType, png::BitDepth) -> Result<()>,
 ) -> Result<Decoded> {
+    let accept = |info: &png::Info| accept(info.color_type, info.bit_depth);
     decode_with(path, reader, png::Transformations::IDENTITY, accept)
 }
 
-/// [`decode`] with the `png` crate's `transformations` applied to the samples.
+/// [`decode`] with the `png` crate's `transformations` applied to the samples; `accept`
+/// judges the whole header.
 fn decode_with(
     path: &Path,
     reader: impl BufRead + Seek,
     transformations: png::Transformations,
-    accept: impl FnOnce(png::ColorType, png::BitDepth) -> Result<()>,
+    accept: impl FnOnce(&png::Info) -> Result<()>,
 ) -> Result<Decoded> {
     let limits = png::Limits {
         bytes: MAX_DECODED_BYTES,
@@ -365,7 +390,8 @@ fn decode_with(
     let mut reader = decoder.read_info().map_err(|e| decode_error(path, e))?;
     let info = reader.info();
     crate::check_pixels(path, info.width as usize, info.height as usize)?;
-    accept(info.color_type, info.bit_depth)?;
+    whole_palette_entries(path, info)?;
+    accept(info)?;
     let len = reader
         .output_buffer_size()
         .ok_or_else(|| Error::corrupt(path, "PNG", "image size overflows memory"))?;
@@ -389,6 +415,19 @@ fn decode_with(
         bytes,
         palette,
     })
+}
+
+/// A PLTE chunk must hold whole RGB entries (PNG 11.2.3); `png` 0.18.1 accepts any length
+/// and then panics expanding a partial entry (image-rs/image-png#694).
+fn whole_palette_entries(path: &Path, info: &png::Info) -> Result<()> {
+    match info.palette.as_deref() {
+        Some(p) if p.len() % 3 != 0 => Err(Error::corrupt(
+            path,
+            "PNG",
+            format!("a PLTE chunk of {} bytes, not whole RGB entries", p.len()),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// A decoded PNG, samples as stored.

@@ -1,5 +1,6 @@
 //! Regressions of the hostile-input issue: tiny files whose headers claim huge images
-//! aborted the process on allocation. Both readers must refuse them from the header.
+//! aborted the process on allocation, and a malformed palette panicked the PNG decoder.
+//! The readers must refuse them from the header.
 
 use std::path::Path;
 
@@ -34,6 +35,7 @@ fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
 /// PNG colour types (IHDR byte 9).
 const GREY: u8 = 0;
 const RGBA: u8 = 6;
+const INDEXED: u8 = 3;
 
 /// A PNG of a few dozen bytes whose header says `w x h`, 16 bits of colour type `color`,
 /// with no pixel data.
@@ -99,6 +101,44 @@ fn tiny_colour_png_is_refused_from_its_header() {
             Err(Error::ColorType { found, .. }) => assert_eq!(found, "Rgba, 16-bit"),
             other => panic!("expected ColorType, got {other:?}"),
         }
+    }
+}
+
+/// An object mask may be of any colour type, so a tiny file claiming 100 MP of 16-bit RGBA
+/// is refused from its header's size against the frame's, before the 800 MB its pixels
+/// would take are allocated (without that check it read as a truncated file after the
+/// allocation).
+#[test]
+fn tiny_mask_claiming_another_size_than_the_frame_is_refused_from_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("objects.png");
+    png_claiming(&path, 10_000, 10_000, RGBA);
+    match polar_io::read_mask_png(&path, (40, 30)) {
+        Err(Error::FrameSize { found, frame, .. }) => {
+            assert_eq!((found, frame), ((10_000, 10_000), (40, 30)))
+        }
+        other => panic!("expected FrameSize, got {other:?}"),
+    }
+}
+
+/// A PLTE chunk whose length is not a whole number of RGB entries (4 bytes) made the `png`
+/// crate (0.18.1) panic while expanding the palette (image-rs/image-png#694); an object
+/// mask is read with that expansion, so the reader refuses such a palette from the header.
+#[test]
+fn palette_of_partial_entries_is_corrupt_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("objects.png");
+    let mut file = b"\x89PNG\r\n\x1a\n".to_vec();
+    file.extend(chunk(b"IHDR", &[0, 0, 0, 1, 0, 0, 0, 1, 8, INDEXED, 0, 0, 0]));
+    file.extend(chunk(b"PLTE", &[255, 0, 0, 7]));
+    // zlib of the one row: filter byte 0, palette index 0.
+    let row = [0x78, 0x9c, 0x63, 0x60, 0x00, 0x00, 0x00, 0x02, 0x00, 0x01];
+    file.extend(chunk(b"IDAT", &row));
+    file.extend(chunk(b"IEND", &[]));
+    std::fs::write(&path, file).unwrap();
+    match polar_io::read_mask_png(&path, (1, 1)) {
+        Err(Error::Corrupt { detail, .. }) => assert!(detail.contains("PLTE"), "{detail}"),
+        other => panic!("expected Corrupt, got {other:?}"),
     }
 }
 

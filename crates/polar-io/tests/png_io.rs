@@ -455,10 +455,11 @@ fn object_masks_read_alike_from_every_png_layout() {
             per_pixel(&[255, 255, 255, 1], &[255, 255, 255, 0]),
         ),
     ];
+    let frame = (w as usize, h as usize);
     for (name, color, depth, data) in layouts {
         let path = dir.path().join(format!("{name}.png"));
         write_raw_png(&path, w, h, color, depth, &data);
-        assert_eq!(read_mask_png(&path).unwrap(), expected, "{name}");
+        assert_eq!(read_mask_png(&path, frame).unwrap(), expected, "{name}");
     }
     let path = dir.path().join("palette.png");
     let palette = [[0, 0, 0], [128, 0, 0], [0, 0, 0]];
@@ -472,11 +473,11 @@ fn object_masks_read_alike_from_every_png_layout() {
         }
     })
     .unwrap();
-    assert_eq!(read_mask_png(&path).unwrap(), expected, "palette");
+    assert_eq!(read_mask_png(&path, frame).unwrap(), expected, "palette");
     let bytes = std::fs::read(&path).unwrap();
     let cut = dir.path().join("cut.png");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    let err = read_mask_png(&cut).unwrap_err();
+    let err = read_mask_png(&cut, frame).unwrap_err();
     assert!(
         matches!(&err, Error::Corrupt { format: "PNG", .. }),
         "{err}"

@@ -232,26 +232,29 @@ fn has_any(gt: &GroundTruth) -> bool {
 }
 
 /// The object mask `--objects` names for `sample`, of the frame's `size`, and the file it
-/// came from: the sample's gt/material.png (label not 0), or a PNG file
-/// ([`polar_io::read_mask_png`]), as given where it exists and else inside the sample
-/// directory.
+/// came from: the sample's gt/material.png (label not 0; its size is checked with the rest
+/// of the ground truth), or a PNG file ([`polar_io::read_mask_png`]), as given where it
+/// exists and else inside the sample directory.
 fn read_objects(
     source: &ObjectsSource,
     sample: &Path,
     gt: &GroundTruth,
     size: (usize, usize),
 ) -> Result<(PathBuf, Gray<u8>), CliError> {
-    let (path, mask) = match source {
+    match source {
         ObjectsSource::GroundTruth => {
             let path = match sample.is_dir() {
                 true => sample.join(files::GT_MATERIAL),
                 false => sample.to_owned(),
             };
-            let mask = object_mask(gt).ok_or_else(|| CliError::Objects {
-                path: path.clone(),
-                reason: "missing: --objects gt reads a sample directory's gt/material.png".into(),
-            })?;
-            (path, mask)
+            match object_mask(gt) {
+                Some(mask) => Ok((path, mask)),
+                None => Err(CliError::Objects {
+                    path,
+                    reason: "missing: --objects gt reads a sample directory's gt/material.png"
+                        .into(),
+                }),
+            }
         }
         ObjectsSource::File(p) => {
             let path = if p.exists() || p.is_absolute() || !sample.is_dir() {
@@ -259,18 +262,20 @@ fn read_objects(
             } else {
                 sample.join(p)
             };
-            let mask = polar_io::read_mask_png(&path)?;
-            (path, mask)
+            match polar_io::read_mask_png(&path, size) {
+                Ok(mask) => Ok((path, mask)),
+                Err(polar_io::Error::FrameSize {
+                    found: (w, h),
+                    frame: (fw, fh),
+                    ..
+                }) => Err(CliError::Objects {
+                    path,
+                    reason: format!("it is {w}x{h}, the frame {fw}x{fh}"),
+                }),
+                Err(e) => Err(e.into()),
+            }
         }
-    };
-    if mask.size() != size {
-        let ((w, h), (fw, fh)) = (mask.size(), size);
-        return Err(CliError::Objects {
-            path,
-            reason: format!("it is {w}x{h}, the frame {fw}x{fh}"),
-        });
     }
-    Ok((path, mask))
 }
 
 /// Ground truth of another size than the input cannot be scored: a clear error.
