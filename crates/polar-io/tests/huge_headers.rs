@@ -129,7 +129,10 @@ fn palette_of_partial_entries_is_corrupt_not_a_panic() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("objects.png");
     let mut file = b"\x89PNG\r\n\x1a\n".to_vec();
-    file.extend(chunk(b"IHDR", &[0, 0, 0, 1, 0, 0, 0, 1, 8, INDEXED, 0, 0, 0]));
+    file.extend(chunk(
+        b"IHDR",
+        &[0, 0, 0, 1, 0, 0, 0, 1, 8, INDEXED, 0, 0, 0],
+    ));
     file.extend(chunk(b"PLTE", &[255, 0, 0, 7]));
     // zlib of the one row: filter byte 0, palette index 0.
     let row = [0x78, 0x9c, 0x63, 0x60, 0x00, 0x00, 0x00, 0x02, 0x00, 0x01];
