@@ -453,6 +453,49 @@ fn outputs_are_identical_whatever_the_jobs() {
     }
 }
 
+/// `eval --shard K/N` then `eval-merge` gives the unsharded report: the shards split the
+/// samples, and the merged per-sample metrics and family means equal an unsharded run's. A
+/// folder given twice is read once; a sample recorded in two folders, or shards evaluated
+/// with other options, are clear errors.
+#[test]
+fn eval_in_shards_merges_into_the_unsharded_report() {
+    let (_whole, all) = eval("sfp", "sfp", "2");
+    let (one, first) = eval_with("sfp", "sfp", "2", &["--shard", "1/2"]);
+    let (two, second) = eval_with("sfp", "sfp", "2", &["--shard", "2/2"]);
+    let names = |m: &serde_json::Value| -> Vec<String> {
+        m["samples"].as_object().unwrap().keys().cloned().collect()
+    };
+    let mut split = [names(&first), names(&second)].concat();
+    split.sort();
+    assert_eq!(split, names(&all), "the shards split the samples");
+    assert!(!names(&first).is_empty() && !names(&second).is_empty());
+    let dir = tempfile::tempdir().unwrap();
+    let merge = |shards: &[&tempfile::TempDir], out: &str| {
+        let out = dir.path().join(out);
+        let mut args = vec!["eval-merge"];
+        args.extend(shards.iter().map(|d| arg(d.path())));
+        args.extend(["--out", arg(&out)]);
+        vision(&args).map(|ok| (ok, out))
+    };
+    let (ok, out) = merge(&[&one, &two, &one], "merged").expect("merge completes");
+    assert!(ok);
+    let merged = json(&out.join(vision::METRICS));
+    assert_eq!(names(&merged), names(&all));
+    for name in names(&all) {
+        let metrics =
+            |m: &serde_json::Value| m["samples"][&name]["Ok"]["tasks"]["sfp"]["metrics"].clone();
+        assert_eq!(metrics(&merged), metrics(&all), "{name}");
+    }
+    let means = |m: &serde_json::Value| m["families"]["sfp"]["sfp"]["means"].clone();
+    assert_eq!(means(&merged), means(&all));
+    let (again, _) = eval_with("sfp", "sfp", "2", &["--shard", "1/2"]);
+    let err = merge(&[&one, &again, &two], "twice").unwrap_err();
+    assert!(err.contains("recorded in two shard folders"), "{err}");
+    let (other, _) = eval_with("sfp", "sfp", "2", &["--shard", "2/2", "--ior", "1.6"]);
+    let err = merge(&[&one, &other], "options").unwrap_err();
+    assert!(err.contains("other options than the first shard"), "{err}");
+}
+
 #[test]
 fn bad_samples_are_recorded_and_the_rest_go_on() {
     let data = tempfile::tempdir().unwrap();

@@ -144,6 +144,16 @@ pub enum CliError {
     /// Shards evaluated with different options cannot be merged.
     #[error("{0}: evaluated with other options than the first shard; cannot merge")]
     MergeOptions(PathBuf),
+    /// One sample recorded in two shard folders: which record counts is not known.
+    #[error("{name}: recorded in two shard folders, {} and {}; give each shard's folder once", first.display(), second.display())]
+    MergeDuplicate {
+        /// The sample.
+        name: String,
+        /// Its record folder in the first shard given.
+        first: PathBuf,
+        /// Its record folder in the other.
+        second: PathBuf,
+    },
     /// A file or folder could not be read or written.
     #[error("{path}: {action}: {reason}")]
     File {

@@ -1,7 +1,7 @@
 //! `polar-vision eval`: every sample of a dataset through `run`, in parallel, resumable and
 //! shardable; per-sample records, aggregates per family and task, and a summary table.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -162,7 +162,8 @@ pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
 /// Arguments of `polar-vision eval-merge`.
 #[derive(Debug, Args)]
 pub struct MergeArgs {
-    /// The `--out` folders of the shards (or one folder all shards wrote into).
+    /// The `--out` folders of the shards (or one folder all shards wrote into). A folder
+    /// given twice is read once; a sample recorded in two of them is an error.
     #[arg(required = true)]
     pub shards: Vec<PathBuf>,
     /// Where the joined metrics.json and summary.md go.
@@ -175,12 +176,23 @@ pub fn merge(args: &MergeArgs) -> Result<bool, CliError> {
     let mut samples = BTreeMap::new();
     let mut dirs = BTreeMap::new();
     let mut options: Option<String> = None;
+    let mut read = BTreeSet::new();
     for dir in &args.shards {
+        if !read.insert(dir.canonicalize().map_err(|e| CliError::read(dir, e))?) {
+            continue;
+        }
         for (name, record) in read_records(dir)? {
+            let here = dir.join("samples").join(&name);
             if options.get_or_insert_with(|| record.options.clone()) != &record.options {
-                return Err(CliError::MergeOptions(dir.join("samples").join(&name)));
+                return Err(CliError::MergeOptions(here));
             }
-            dirs.insert(name.clone(), dir.join("samples").join(&name));
+            if let Some(first) = dirs.insert(name.clone(), here.clone()) {
+                return Err(CliError::MergeDuplicate {
+                    name,
+                    first,
+                    second: here,
+                });
+            }
             samples.insert(name, record.result);
         }
     }
