@@ -455,8 +455,9 @@ fn outputs_are_identical_whatever_the_jobs() {
 
 /// `eval --shard K/N` then `eval-merge` gives the unsharded report: the shards split the
 /// samples, and the merged per-sample metrics and family means equal an unsharded run's. A
-/// folder given twice is read once; a sample recorded in two folders, or shards evaluated
-/// with other options, are clear errors.
+/// folder given twice is read once; a sample recorded in two folders, shards evaluated with
+/// other options or over another selection of samples, and a missing shard are clear
+/// errors.
 #[test]
 fn eval_in_shards_merges_into_the_unsharded_report() {
     let (_whole, all) = eval("sfp", "sfp", "2");
@@ -494,6 +495,22 @@ fn eval_in_shards_merges_into_the_unsharded_report() {
     let (other, _) = eval_with("sfp", "sfp", "2", &["--shard", "2/2", "--ior", "1.6"]);
     let err = merge(&[&one, &other], "options").unwrap_err();
     assert!(err.contains("other options than the first shard"), "{err}");
+    let err = merge(&[&one], "half").unwrap_err();
+    let half = format!(
+        "hold {} of the {} samples",
+        first["samples"].as_object().unwrap().len(),
+        split.len()
+    );
+    assert!(
+        err.contains(&half) && err.contains("shard(s) 1 of 2"),
+        "{err}"
+    );
+    let report = two.path().join(vision::METRICS);
+    let mut m = json(&report);
+    m["selection"]["samples"] = serde_json::json!(split.len() + 1);
+    std::fs::write(&report, m.to_string()).unwrap();
+    let err = merge(&[&one, &two], "selection").unwrap_err();
+    assert!(err.contains("another selection of samples"), "{err}");
 }
 
 #[test]

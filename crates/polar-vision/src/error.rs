@@ -144,6 +144,23 @@ pub enum CliError {
     /// Shards evaluated with different options cannot be merged.
     #[error("{0}: evaluated with other options than the first shard; cannot merge")]
     MergeOptions(PathBuf),
+    /// Shards of different selections of samples cannot be merged.
+    #[error("{}: evaluated over another selection of samples (dataset, --family or number of shards) than the first shard; cannot merge", .0.display())]
+    MergeSelection(PathBuf),
+    /// The shards given miss samples of their selection.
+    #[error(
+        "the shards given hold {found} of the {expected} samples their evaluation selected (shard(s) {seen} of {shards} given): a shard is missing or did not finish"
+    )]
+    MergeIncomplete {
+        /// Samples recorded in the shards given.
+        found: usize,
+        /// Samples of the selection.
+        expected: usize,
+        /// The shards given, e.g. `1, 3`.
+        seen: String,
+        /// Number of shards.
+        shards: u32,
+    },
     /// One sample recorded in two shard folders: which record counts is not known.
     #[error("{name}: recorded in two shard folders, {} and {}; give each shard's folder once", first.display(), second.display())]
     MergeDuplicate {

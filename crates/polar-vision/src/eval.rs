@@ -103,11 +103,26 @@ pub struct Record {
     pub result: Result<SampleReport, String>,
 }
 
+/// Which samples an evaluation covered: shard `shard` of `shards` of the `samples` its
+/// dataset and `--family` selected, so that `eval-merge` can tell a missing shard.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Selection {
+    /// The shard, 1..=`shards`.
+    pub shard: u32,
+    /// Number of shards.
+    pub shards: u32,
+    /// Samples of the whole selection, every shard's.
+    pub samples: usize,
+}
+
 /// `OUT/metrics.json` of `eval`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct EvalReport {
     /// Layout version.
     pub schema_version: u32,
+    /// The samples the evaluation covered (absent in reports of earlier versions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selection: Option<Selection>,
     /// Per sample (folder name): the report or the error.
     pub samples: BTreeMap<String, Result<SampleReport, String>>,
     /// Per family, per task: means of every metric, counts and time per megapixel.
@@ -147,10 +162,16 @@ pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
         .iter()
         .map(|(n, _)| (n.clone(), out.join("samples").join(n)))
         .collect();
+    let selection = Selection {
+        shard: shard.k,
+        shards: shard.n,
+        samples: samples.len(),
+    };
     let report = write_report(
         out,
         records.into_iter().map(|(n, r)| (n, r.result)).collect(),
         &dirs,
+        Some(selection),
     )?;
     print_failures(&report);
     Ok(report
@@ -163,7 +184,9 @@ pub fn eval(args: &EvalArgs) -> Result<bool, CliError> {
 #[derive(Debug, Args)]
 pub struct MergeArgs {
     /// The `--out` folders of the shards (or one folder all shards wrote into). A folder
-    /// given twice is read once; a sample recorded in two of them is an error.
+    /// given twice is read once; a sample recorded in two of them, shards of other options
+    /// or of another selection of samples, and shards that together miss samples of their
+    /// selection (a shard not given or not finished) are errors.
     #[arg(required = true)]
     pub shards: Vec<PathBuf>,
     /// Where the joined metrics.json and summary.md go.
@@ -177,10 +200,12 @@ pub fn merge(args: &MergeArgs) -> Result<bool, CliError> {
     let mut dirs = BTreeMap::new();
     let mut options: Option<String> = None;
     let mut read = BTreeSet::new();
+    let mut selections = Vec::new();
     for dir in &args.shards {
         if !read.insert(dir.canonicalize().map_err(|e| CliError::read(dir, e))?) {
             continue;
         }
+        selections.push((dir, read_selection(dir)?));
         for (name, record) in read_records(dir)? {
             let here = dir.join("samples").join(&name);
             if options.get_or_insert_with(|| record.options.clone()) != &record.options {
@@ -199,10 +224,65 @@ pub fn merge(args: &MergeArgs) -> Result<bool, CliError> {
     if samples.is_empty() {
         return Err(CliError::NoSamples(args.shards[0].clone()));
     }
+    let selection = whole_selection(&selections, samples.len())?;
     prepare_resumable(&args.out)?;
-    let report = write_report(&args.out, samples, &dirs)?;
+    let report = write_report(&args.out, samples, &dirs, selection)?;
     print_failures(&report);
     Ok(report.samples.values().all(Result::is_ok))
+}
+
+/// The [`Selection`] in a shard folder's metrics.json; `None` where the file or the entry
+/// is absent (a report of an earlier version, or a shard that wrote none).
+fn read_selection(dir: &Path) -> Result<Option<Selection>, CliError> {
+    #[derive(Deserialize)]
+    struct Head {
+        #[serde(default)]
+        selection: Option<Selection>,
+    }
+    let path = dir.join(files::vision::METRICS);
+    if !path.is_file() {
+        return Ok(None);
+    }
+    Ok(polar_io::read_json::<Head>(&path)?.selection)
+}
+
+/// The selection the merged shards make up, after checking that they come from one
+/// selection and that together they hold all of its `found` samples; `None`, unchecked,
+/// when a shard folder does not say its selection.
+fn whole_selection(
+    selections: &[(&PathBuf, Option<Selection>)],
+    found: usize,
+) -> Result<Option<Selection>, CliError> {
+    let Some(known) = selections
+        .iter()
+        .map(|(_, s)| *s)
+        .collect::<Option<Vec<Selection>>>()
+    else {
+        return Ok(None);
+    };
+    let first = known[0];
+    let same = |s: &Selection| (s.shards, s.samples) == (first.shards, first.samples);
+    if let Some(i) = known.iter().position(|s| !same(s)) {
+        return Err(CliError::MergeSelection(selections[i].0.clone()));
+    }
+    if found != first.samples {
+        let seen: BTreeSet<u32> = known.iter().map(|s| s.shard).collect();
+        return Err(CliError::MergeIncomplete {
+            found,
+            expected: first.samples,
+            seen: seen
+                .iter()
+                .map(u32::to_string)
+                .collect::<Vec<_>>()
+                .join(", "),
+            shards: first.shards,
+        });
+    }
+    Ok(Some(Selection {
+        shard: 1,
+        shards: 1,
+        samples: found,
+    }))
 }
 
 /// The sample directories under `dataset`, sorted by name (hidden folders skipped).
@@ -292,6 +372,7 @@ fn write_report(
     out: &Path,
     samples: BTreeMap<String, Result<SampleReport, String>>,
     dirs: &BTreeMap<String, PathBuf>,
+    selection: Option<Selection>,
 ) -> Result<EvalReport, CliError> {
     let ok: BTreeMap<String, BTreeMap<String, Summary>> = samples
         .iter()
@@ -299,6 +380,7 @@ fn write_report(
         .collect();
     let report = EvalReport {
         schema_version: SCHEMA_VERSION,
+        selection,
         families: aggregate(&ok),
         samples,
     };
