@@ -2,7 +2,8 @@
 # The whole test suite, as CI runs it (see README "Set-up"):
 #   1. the pinned Python references (tools/.venv) and Debian's libllvm19 for Mitsuba,
 #   2. formatting, lints and the API docs,
-#   3. every Rust test in release mode (numeric-heavy),
+#   3. every Rust test in release mode (numeric-heavy), and the cluster job scripts run
+#      as their array tasks would,
 #   4. the cross-checks that regenerate reference outputs with the pinned Python
 #      packages and compare them with ours (drift in either side fails the run).
 set -euo pipefail
@@ -24,6 +25,10 @@ RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked --quiet
 
 step "cargo test --release"
 cargo test --workspace --release --locked
+
+step "cluster job files: the Slurm array scripts as array tasks, then merged"
+cargo build --release --locked -p polar-datagen -p polar-vision --quiet
+tools/cluster_check.sh
 
 py=tools/.venv/bin/python
 step "image primitives vs opencv-contrib / scikit-image"
