@@ -513,6 +513,63 @@ fn eval_in_shards_merges_into_the_unsharded_report() {
     assert!(err.contains("another selection of samples"), "{err}");
 }
 
+/// Copies the shape sample `src` (meta.json, raw.png, true normals and labels) to `dst`.
+fn copy_sample(src: &std::path::Path, dst: &std::path::Path) {
+    std::fs::create_dir_all(dst.join(files::GT_DIR)).unwrap();
+    for f in [
+        files::META,
+        files::RAW,
+        files::GT_NORMAL,
+        files::GT_MATERIAL,
+    ] {
+        std::fs::copy(src.join(f), dst.join(f)).unwrap();
+    }
+}
+
+/// `eval --tasks sfp` of the samples under `data` into `out`.
+fn eval_sfp(data: &std::path::Path, out: &std::path::Path) -> Result<bool, String> {
+    vision(&["eval", arg(data), "--out", arg(out), "--tasks", "sfp"])
+}
+
+/// A resumed `eval` reuses a sample's record only while the sample's files are the ones it
+/// was made from: rerunning changes nothing, and a sample whose raw.png was replaced (a
+/// dataset rendered again into the same folder) is run again, the others not.
+#[test]
+fn a_resumed_eval_reruns_a_sample_whose_files_changed() {
+    let data = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    for name in ["sfp-00000", "sfp-00001"] {
+        copy_sample(&standard_ci().join(name), &data.path().join(name));
+    }
+    let eval = || assert_eq!(eval_sfp(data.path(), out.path()), Ok(true));
+    let record = |name: &str| {
+        let path = out
+            .path()
+            .join("samples")
+            .join(name)
+            .join(vision::EVAL_RECORD);
+        std::fs::read(path).unwrap()
+    };
+    eval();
+    let (first, second) = (record("sfp-00000"), record("sfp-00001"));
+    eval();
+    assert!(
+        record("sfp-00000") == first,
+        "an unchanged sample ran again"
+    );
+    let raw = |name: &str| data.path().join(name).join(files::RAW);
+    std::fs::copy(raw("sfp-00001"), raw("sfp-00000")).unwrap();
+    eval();
+    assert!(
+        record("sfp-00000") != first,
+        "a changed sample resumed from its old record"
+    );
+    assert!(
+        record("sfp-00001") == second,
+        "an unchanged sample ran again"
+    );
+}
+
 #[test]
 fn bad_samples_are_recorded_and_the_rest_go_on() {
     let data = tempfile::tempdir().unwrap();
@@ -523,16 +580,7 @@ fn bad_samples_are_recorded_and_the_rest_go_on() {
     // One good sample, one with a corrupt raw.png, one whose gt is of another size.
     let src = standard_ci().join("sfp-00000");
     for name in ["good-0", "corrupt-0", "mismatch-0"] {
-        let dst = data.path().join(name);
-        std::fs::create_dir_all(dst.join(files::GT_DIR)).unwrap();
-        for f in [
-            files::META,
-            files::RAW,
-            files::GT_NORMAL,
-            files::GT_MATERIAL,
-        ] {
-            std::fs::copy(src.join(f), dst.join(f)).unwrap();
-        }
+        copy_sample(&src, &data.path().join(name));
     }
     std::fs::write(
         data.path().join("corrupt-0/raw.png"),
@@ -542,14 +590,7 @@ fn bad_samples_are_recorded_and_the_rest_go_on() {
     let small = polar_image::Gray::from_vec(2, 2, vec![1u8; 4]).unwrap();
     polar_io::write_gray8_png(data.path().join("mismatch-0/gt/material.png"), &small).unwrap();
     std::fs::remove_file(data.path().join("mismatch-0/gt/normal.exr")).unwrap();
-    let ok = vision(&[
-        "eval",
-        arg(data.path()),
-        "--out",
-        arg(out.path()),
-        "--tasks",
-        "sfp",
-    ]);
+    let ok = eval_sfp(data.path(), out.path());
     assert_eq!(ok, Ok(false), "eval completes and reports the failures");
     let m = json(&out.path().join(vision::METRICS));
     let err = |s: &str| {

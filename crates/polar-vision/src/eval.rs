@@ -27,7 +27,8 @@ const RECORD: &str = polar_io::files::vision::EVAL_RECORD;
 eval.json, its record), OUT/metrics.json (schema_version, per sample keyed by folder name, \
 aggregates per family and task) and OUT/summary.md (a table). A sample that fails is recorded \
 and the others go on. Rerunning the same command resumes: samples with a record made with the \
-same options are not run again. With --shard K/N only the samples whose index i (sorted by \
+same options from the same files (names, sizes and modification times under the sample's \
+folder) are not run again. With --shard K/N only the samples whose index i (sorted by \
 name) has i mod N = K-1 are run; `polar-vision eval-merge` joins the shards' outputs."
 )]
 pub struct EvalArgs {
@@ -99,6 +100,10 @@ impl EvalRunArgs {
 pub struct Record {
     /// The options it was made with ([`EvalRunArgs`]).
     pub options: String,
+    /// The files under the sample's folder it was made from, with their sizes and
+    /// modification times (empty in records of earlier versions, which are made again).
+    #[serde(default)]
+    pub inputs: String,
     /// The run's report, or why the sample could not be read.
     pub result: Result<SampleReport, String>,
 }
@@ -327,7 +332,8 @@ fn sample_name(sample: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// Runs one sample unless its record with the same options exists; records the result.
+/// Runs one sample unless its record made with the same options from the same files
+/// exists; records the result.
 fn evaluate_one(
     sample: &Path,
     out: &Path,
@@ -337,19 +343,50 @@ fn evaluate_one(
     let name = sample_name(sample);
     let dir = out.join("samples").join(&name);
     let path = dir.join(RECORD);
+    let inputs = input_stamp(sample)?;
     if let Ok(old) = polar_io::read_json::<Record>(&path)
         && old.options == fingerprint
+        && old.inputs == inputs
     {
         return Ok((name, old));
     }
     let result = run_sample(sample, &dir, &run.as_run(sample, &dir)).map_err(|e| e.to_string());
     let record = Record {
         options: fingerprint.to_owned(),
+        inputs,
         result,
     };
     prepare_resumable(&dir)?;
     polar_io::write_json(&path, &record)?;
     Ok((name, record))
+}
+
+/// The files under `sample`, each with its size and modification time, in name order: a
+/// sample rendered again or a file of it replaced since its record was made does not
+/// resume from that record.
+fn input_stamp(sample: &Path) -> Result<String, CliError> {
+    let mut files = Vec::new();
+    let mut folders = vec![sample.to_owned()];
+    while let Some(folder) = folders.pop() {
+        let entries = std::fs::read_dir(&folder).map_err(|e| CliError::read(&folder, e))?;
+        for entry in entries {
+            let path = entry.map_err(|e| CliError::read(&folder, e))?.path();
+            let meta = std::fs::metadata(&path).map_err(|e| CliError::read(&path, e))?;
+            if meta.is_dir() {
+                folders.push(path);
+                continue;
+            }
+            let modified = meta
+                .modified()
+                .ok()
+                .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+                .map_or(0, |d| d.as_nanos());
+            let name = path.strip_prefix(sample).unwrap_or(&path).display();
+            files.push(format!("{name} {} {modified}", meta.len()));
+        }
+    }
+    files.sort();
+    Ok(files.join("; "))
 }
 
 fn read_records(dir: &Path) -> Result<Vec<(String, Record)>, CliError> {
