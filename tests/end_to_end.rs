@@ -533,7 +533,8 @@ fn eval_sfp(data: &std::path::Path, out: &std::path::Path) -> Result<bool, Strin
 
 /// A resumed `eval` reuses a sample's record only while the sample's files are the ones it
 /// was made from: rerunning changes nothing, and a sample whose raw.png was replaced (a
-/// dataset rendered again into the same folder) is run again, the others not.
+/// dataset rendered again into the same folder) is run again, the others not. A symbolic
+/// link in a sample to a folder above it is no loop.
 #[test]
 fn a_resumed_eval_reruns_a_sample_whose_files_changed() {
     let data = tempfile::tempdir().unwrap();
@@ -541,6 +542,9 @@ fn a_resumed_eval_reruns_a_sample_whose_files_changed() {
     for name in ["sfp-00000", "sfp-00001"] {
         copy_sample(&standard_ci().join(name), &data.path().join(name));
     }
+    // A link back to the dataset inside a sample is stamped, not walked into.
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(data.path(), data.path().join("sfp-00001/dataset")).unwrap();
     let eval = || assert_eq!(eval_sfp(data.path(), out.path()), Ok(true));
     let record = |name: &str| {
         let path = out

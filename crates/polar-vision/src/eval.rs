@@ -361,32 +361,39 @@ fn evaluate_one(
     Ok((name, record))
 }
 
-/// The files under `sample`, each with its size and modification time, in name order: a
-/// sample rendered again or a file of it replaced since its record was made does not
-/// resume from that record.
+/// The files under `sample`, each with its size and modification time (a symbolic link's
+/// target's; a link is not descended into, so a link to a parent folder is no loop), in
+/// name order: a sample rendered again or a file of it replaced since its record was made
+/// does not resume from that record.
 fn input_stamp(sample: &Path) -> Result<String, CliError> {
     let mut files = Vec::new();
     let mut folders = vec![sample.to_owned()];
     while let Some(folder) = folders.pop() {
         let entries = std::fs::read_dir(&folder).map_err(|e| CliError::read(&folder, e))?;
         for entry in entries {
-            let path = entry.map_err(|e| CliError::read(&folder, e))?.path();
-            let meta = std::fs::metadata(&path).map_err(|e| CliError::read(&path, e))?;
-            if meta.is_dir() {
+            let entry = entry.map_err(|e| CliError::read(&folder, e))?;
+            let path = entry.path();
+            if entry.file_type().is_ok_and(|t| t.is_dir()) {
                 folders.push(path);
                 continue;
             }
-            let modified = meta
-                .modified()
-                .ok()
-                .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
-                .map_or(0, |d| d.as_nanos());
             let name = path.strip_prefix(sample).unwrap_or(&path).display();
-            files.push(format!("{name} {} {modified}", meta.len()));
+            files.push(match std::fs::metadata(&path) {
+                Ok(meta) => format!("{name} {} {}", meta.len(), modified_nanos(&meta)),
+                Err(_) => format!("{name} unreadable"),
+            });
         }
     }
     files.sort();
     Ok(files.join("; "))
+}
+
+/// Modification time in nanoseconds since the Unix epoch, 0 where the system gives none.
+fn modified_nanos(meta: &std::fs::Metadata) -> u128 {
+    meta.modified()
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .map_or(0, |d| d.as_nanos())
 }
 
 fn read_records(dir: &Path) -> Result<Vec<(String, Record)>, CliError> {
