@@ -343,7 +343,7 @@ fn evaluate_one(
     let name = sample_name(sample);
     let dir = out.join("samples").join(&name);
     let path = dir.join(RECORD);
-    let inputs = input_stamp(sample)?;
+    let inputs = input_stamp(sample);
     if let Ok(old) = polar_io::read_json::<Record>(&path)
         && old.options == fingerprint
         && old.inputs == inputs
@@ -364,14 +364,17 @@ fn evaluate_one(
 /// The files under `sample`, each with its size and modification time (a symbolic link's
 /// target's; a link is not descended into, so a link to a parent folder is no loop), in
 /// name order: a sample rendered again or a file of it replaced since its record was made
-/// does not resume from that record.
-fn input_stamp(sample: &Path) -> Result<String, CliError> {
+/// does not resume from that record. What cannot be read is stamped as such; reading the
+/// sample then fails in its run, which its record keeps.
+fn input_stamp(sample: &Path) -> String {
     let mut files = Vec::new();
     let mut folders = vec![sample.to_owned()];
     while let Some(folder) = folders.pop() {
-        let entries = std::fs::read_dir(&folder).map_err(|e| CliError::read(&folder, e))?;
-        for entry in entries {
-            let entry = entry.map_err(|e| CliError::read(&folder, e))?;
+        let Ok(entries) = std::fs::read_dir(&folder) else {
+            files.push(format!("{} unreadable", folder.display()));
+            continue;
+        };
+        for entry in entries.flatten() {
             let path = entry.path();
             if entry.file_type().is_ok_and(|t| t.is_dir()) {
                 folders.push(path);
@@ -385,7 +388,7 @@ fn input_stamp(sample: &Path) -> Result<String, CliError> {
         }
     }
     files.sort();
-    Ok(files.join("; "))
+    files.join("; ")
 }
 
 /// Modification time in nanoseconds since the Unix epoch, 0 where the system gives none.
