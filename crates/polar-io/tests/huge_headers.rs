@@ -106,8 +106,7 @@ fn tiny_colour_png_is_refused_from_its_header() {
 
 /// An object mask may be of any colour type, so a tiny file claiming 100 MP of 16-bit RGBA
 /// is refused from its header's size against the frame's, before the 800 MB its pixels
-/// would take are allocated (without that check it read as a truncated file after the
-/// allocation).
+/// would take exist.
 #[test]
 fn tiny_mask_claiming_another_size_than_the_frame_is_refused_from_its_header() {
     let dir = tempfile::tempdir().unwrap();

@@ -101,7 +101,7 @@ pub struct Record {
     /// The options it was made with ([`EvalRunArgs`]).
     pub options: String,
     /// The files under the sample's folder it was made from, with their sizes and
-    /// modification times (empty in records of earlier versions, which are made again).
+    /// modification times ([`Record`]s without it match no sample and are made again).
     #[serde(default)]
     pub inputs: String,
     /// The run's report, or why the sample could not be read.

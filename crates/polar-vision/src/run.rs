@@ -262,18 +262,8 @@ fn read_objects(
             } else {
                 sample.join(p)
             };
-            match polar_io::read_mask_png(&path, size) {
-                Ok(mask) => Ok((path, mask)),
-                Err(polar_io::Error::FrameSize {
-                    found: (w, h),
-                    frame: (fw, fh),
-                    ..
-                }) => Err(CliError::Objects {
-                    path,
-                    reason: format!("it is {w}x{h}, the frame {fw}x{fh}"),
-                }),
-                Err(e) => Err(e.into()),
-            }
+            let mask = polar_io::read_mask_png(&path, size)?;
+            Ok((path, mask))
         }
     }
 }
